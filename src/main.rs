@@ -1,0 +1,177 @@
+//! The `lodeval` command line: parse (clap derive), call the library, map errors to exit codes
+//! (0 ok · 1 regression or golden mismatch · 2 bad input or usage · 3 internal error). No logic.
+
+use std::io::Write;
+use std::path::PathBuf;
+use std::process::ExitCode;
+use std::sync::Mutex;
+
+use clap::{Args, Parser, Subcommand, ValueEnum};
+use lodeval::{Error, LoadOptions, MeshSummary, MissingAssets};
+
+#[derive(Parser, Debug)]
+#[command(
+    name = "lodeval",
+    version,
+    about = "Does a simplified mesh still look like the original, and from how far away can nobody tell them apart?"
+)]
+struct Cli {
+    /// Worker threads (default: all cores). Results are identical for any value.
+    #[arg(long, global = true, value_name = "N")]
+    threads: Option<usize>,
+    /// No progress output.
+    #[arg(long, short, global = true)]
+    quiet: bool,
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand, Debug)]
+enum Command {
+    /// Print what a mesh file contains: counts, attributes, materials, textures, bounds.
+    Info(InfoArgs),
+    /// Render a mesh from the view rig (not built yet).
+    Render(NotYet),
+    /// Compare two images with the perceptual metrics (not built yet).
+    Diff(NotYet),
+    /// Run a batch evaluation config (not built yet).
+    Eval(NotYet),
+    /// Compare renders with golden images, or bless new ones (not built yet).
+    Golden(NotYet),
+    /// Simplify a mesh (not built yet).
+    Simplify(NotYet),
+    /// Image-driven optimisation of a simplified mesh (not built yet).
+    Optimize(NotYet),
+    /// Run the benchmarks (not built yet).
+    Bench(NotYet),
+    /// Merge the outputs of sharded runs (not built yet).
+    Merge(NotYet),
+}
+
+#[derive(Args, Debug)]
+struct InfoArgs {
+    /// The mesh file (.obj, .ply, .gltf, .glb, .off).
+    mesh: PathBuf,
+    /// Print JSON instead of text.
+    #[arg(long)]
+    json: bool,
+    #[command(flatten)]
+    load: LoadArgs,
+}
+
+#[derive(Args, Debug)]
+struct LoadArgs {
+    /// What to do when a texture or material library is missing or undecodable.
+    #[arg(long, value_enum, default_value_t = MissingArg::Error)]
+    missing_assets: MissingArg,
+    /// Crease angle in degrees for computed normals (180 = smooth everywhere).
+    #[arg(long, default_value_t = 180.0, value_name = "DEGREES")]
+    crease_angle: f32,
+}
+
+#[derive(Copy, Clone, Debug, ValueEnum)]
+enum MissingArg {
+    /// Fail with a message naming the file.
+    Error,
+    /// Warn and render with the material's base colour.
+    Warn,
+}
+
+/// Arguments of a subcommand that is not built yet, accepted so the message is about that.
+#[derive(Args, Debug)]
+struct NotYet {
+    #[arg(trailing_var_arg = true, allow_hyphen_values = true, hide = true)]
+    args: Vec<String>,
+}
+
+impl LoadArgs {
+    fn options(&self) -> Result<LoadOptions, Error> {
+        if !(0.0..=180.0).contains(&self.crease_angle) {
+            return Err(Error::Usage(format!(
+                "--crease-angle {} is outside 0..180 degrees",
+                self.crease_angle
+            )));
+        }
+        let mut o = LoadOptions::DEFAULT;
+        o.missing_assets = match self.missing_assets {
+            MissingArg::Error => MissingAssets::Error,
+            MissingArg::Warn => MissingAssets::Warn,
+        };
+        o.crease_angle_deg = self.crease_angle;
+        Ok(o)
+    }
+}
+
+/// Write to stdout; a closed pipe (e.g. `| head`) is not an error.
+fn emit(text: &str) -> Result<(), Error> {
+    let mut out = std::io::stdout().lock();
+    match out.write_all(text.as_bytes()).and_then(|_| out.flush()) {
+        Err(e) if e.kind() != std::io::ErrorKind::BrokenPipe => Err(Error::Internal(format!(
+            "cannot write to standard output: {e}"
+        ))),
+        _ => Ok(()),
+    }
+}
+
+fn run(cli: Cli) -> Result<(), Error> {
+    if let Some(n) = cli.threads {
+        if n == 0 {
+            return Err(Error::Usage("--threads must be at least 1".into()));
+        }
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(n)
+            .build_global()
+            .map_err(|e| Error::Internal(format!("cannot start {n} worker threads: {e}")))?;
+    }
+    let _ = cli.quiet;
+    match cli.command {
+        Command::Info(a) => {
+            let mesh = lodeval::mesh::load(&a.mesh, &a.load.options()?)?;
+            let summary = MeshSummary::of(&mesh);
+            if a.json {
+                let json = serde_json::to_string_pretty(&summary)
+                    .map_err(|e| Error::Internal(e.to_string()))?;
+                emit(&(json + "\n"))
+            } else {
+                emit(&summary.to_string())
+            }
+        }
+        other => {
+            let name = format!("{other:?}")
+                .split('(')
+                .next()
+                .unwrap_or("")
+                .to_lowercase();
+            Err(Error::Usage(format!(
+                "`lodeval {name}` is not built yet; this build can run `lodeval info`"
+            )))
+        }
+    }
+}
+
+/// The message of the last panic, kept so a crash is reported once, as an internal error.
+static PANIC_MESSAGE: Mutex<Option<String>> = Mutex::new(None);
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    std::panic::set_hook(Box::new(|info| {
+        if let Ok(mut slot) = PANIC_MESSAGE.lock() {
+            *slot = Some(info.to_string());
+        }
+    }));
+    let outcome = std::panic::catch_unwind(move || run(cli)).unwrap_or_else(|_| {
+        let msg = PANIC_MESSAGE
+            .lock()
+            .ok()
+            .and_then(|m| m.clone())
+            .unwrap_or_default();
+        Err(Error::Internal(msg))
+    });
+    match outcome {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {e}");
+            ExitCode::from(e.exit_code())
+        }
+    }
+}

@@ -1,0 +1,427 @@
+//! Wavefront OBJ + MTL loader (parsing by `tobj`).
+//!
+//! Steps: read and UTF-8-check the file; `scan` it once ourselves, which (a) gives line numbers
+//! for every error `tobj` would only name by kind (bad numbers, NaN coordinates, face indices out of
+//! range or before their vertex), (b) counts records for `lodeval info`, and (c) moves `mtllib`
+//! lines to the front, because `tobj` binds `usemtl` names only to libraries already read and some
+//! exporters write `mtllib` last (Crane's Bob); then `tobj` parses the text, and we build vertices
+//! from the distinct (position, UV, normal) index triples, so seams split vertices.
+//!
+//! Decisions: `l` and `p` records (lines, points) are ignored; polygons are fan-triangulated by
+//! `tobj`; OBJ vertex colours are taken as sRGB-encoded values in 0..1 and linearised; `map_Bump`,
+//! `bump` and `norm` all name a tangent-space normal map.
+
+use std::collections::HashMap;
+use std::io::Cursor;
+use std::path::{Path, PathBuf};
+
+use glam::{Vec2, Vec3};
+
+use super::texture::{ColorSpace, TextureCache, resolve_asset_path};
+use super::{Format, LoadOptions, Material, MeshData, MissingAssets, Source, read_file};
+use crate::error::{Error, Location, Result};
+use crate::metric::color::srgb_to_linear;
+
+const FIX_SYNTAX: &str = "fix or delete that line, or re-export the OBJ";
+
+/// What the line scan found.
+struct Scan {
+    positions: usize,
+    faces: usize,
+    mtllibs: Vec<(usize, String)>,
+    /// The text with every `mtllib`, `l` and `p` line blanked and the `mtllib` lines prepended.
+    text: String,
+}
+
+/// Parse `count` floats from the tokens, or say which line is wrong.
+fn floats(
+    path: &Path,
+    line_no: usize,
+    tokens: &mut std::str::SplitWhitespace<'_>,
+    count: usize,
+    what: &str,
+) -> Result<[f32; 3]> {
+    let mut out = [0.0; 3];
+    for (i, slot) in out.iter_mut().enumerate().take(count) {
+        let tok = tokens.next().ok_or_else(|| {
+            Error::input_at(
+                path,
+                Location::Line(line_no),
+                format!("{what} record has {i} numbers; it needs {count}"),
+                FIX_SYNTAX,
+            )
+        })?;
+        *slot = tok.parse::<f32>().map_err(|_| {
+            Error::input_at(
+                path,
+                Location::Line(line_no),
+                format!("'{tok}' in a {what} record is not a number"),
+                FIX_SYNTAX,
+            )
+        })?;
+        if !slot.is_finite() {
+            return Err(Error::input_at(
+                path,
+                Location::Line(line_no),
+                format!("{what} record has a non-finite value '{tok}'"),
+                "replace NaN/inf coordinates with real values or delete the vertex and its faces",
+            ));
+        }
+    }
+    Ok(out)
+}
+
+/// Check one face-vertex token `p[/t[/n]]` against the records defined so far.
+fn face_ref(path: &Path, line_no: usize, tok: &str, counts: [usize; 3]) -> Result<()> {
+    const NAMES: [&str; 3] = ["vertex", "texture coordinate", "normal"];
+    for (slot, part) in tok.split('/').enumerate().take(3) {
+        if part.is_empty() && slot > 0 {
+            continue;
+        }
+        let idx: i64 = part.parse().map_err(|_| {
+            Error::input_at(
+                path,
+                Location::Line(line_no),
+                format!("face entry '{tok}' is not of the form v, v/vt, v//vn or v/vt/vn"),
+                FIX_SYNTAX,
+            )
+        })?;
+        let n = counts[slot] as i64;
+        let resolved = if idx < 0 { n + idx + 1 } else { idx };
+        if idx == 0 || resolved < 1 || resolved > n {
+            return Err(Error::input_at(
+                path,
+                Location::Line(line_no),
+                format!(
+                    "face refers to {} {idx}, but only {n} {}s are defined before this line",
+                    NAMES[slot], NAMES[slot]
+                ),
+                "fix the face indices (OBJ indices start at 1) or add the missing records",
+            ));
+        }
+    }
+    Ok(())
+}
+
+fn scan(path: &Path, text: &str) -> Result<Scan> {
+    let mut counts = [0usize; 3];
+    let mut faces = 0;
+    let mut mtllibs = Vec::new();
+    let mut body = String::with_capacity(text.len() + 64);
+    for (i, raw) in text.split('\n').enumerate() {
+        let line_no = i + 1;
+        let line = raw.strip_suffix('\r').unwrap_or(raw);
+        let mut tokens = line.split_whitespace();
+        let keep = match tokens.next() {
+            Some("v") => {
+                floats(path, line_no, &mut tokens, 3, "vertex")?;
+                counts[0] += 1;
+                true
+            }
+            Some("vt") => {
+                floats(path, line_no, &mut tokens, 2, "texture coordinate")?;
+                counts[1] += 1;
+                true
+            }
+            Some("vn") => {
+                floats(path, line_no, &mut tokens, 3, "normal")?;
+                counts[2] += 1;
+                true
+            }
+            Some("f") => {
+                let mut corners = 0;
+                for tok in tokens {
+                    face_ref(path, line_no, tok, counts)?;
+                    corners += 1;
+                }
+                if corners < 3 {
+                    return Err(Error::input_at(
+                        path,
+                        Location::Line(line_no),
+                        format!("face has {corners} vertices; a face needs at least 3"),
+                        FIX_SYNTAX,
+                    ));
+                }
+                faces += 1;
+                true
+            }
+            Some("mtllib") => {
+                let name = line.trim_start()["mtllib".len()..].trim();
+                mtllibs.push((line_no, name.to_string()));
+                false
+            }
+            Some("l") | Some("p") => false,
+            _ => true,
+        };
+        // Keep the line count identical so any later tobj complaint maps to the same lines.
+        if keep {
+            body.push_str(line);
+        }
+        body.push('\n');
+    }
+    let mut text = String::with_capacity(body.len() + 64);
+    for (_, name) in &mtllibs {
+        text.push_str("mtllib ");
+        text.push_str(name);
+        text.push('\n');
+    }
+    text.push_str(&body);
+    Ok(Scan {
+        positions: counts[0],
+        faces,
+        mtllibs,
+        text,
+    })
+}
+
+/// Load an OBJ file and the MTL libraries and textures it names.
+pub(crate) fn load(path: &Path, options: &LoadOptions) -> Result<MeshData> {
+    let bytes = read_file(path)?;
+    let text = String::from_utf8(bytes).map_err(|e| {
+        let valid = &e.as_bytes()[..e.utf8_error().valid_up_to()];
+        let line = valid.iter().filter(|&&b| b == b'\n').count() + 1;
+        Error::input_at(
+            path,
+            Location::Line(line),
+            "the file is not text (invalid UTF-8); is it really an OBJ file?",
+            "re-export it as a text OBJ",
+        )
+    })?;
+    let scan = scan(path, &text)?;
+    let dir = path.parent().unwrap_or(Path::new(".")).to_path_buf();
+    let mut warnings = Vec::new();
+
+    // Material libraries: a missing one is an error unless the user asked for warnings.
+    let mut mtl_paths: HashMap<String, PathBuf> = HashMap::new();
+    for (line_no, name) in &scan.mtllibs {
+        let resolved = resolve_asset_path(&dir, name);
+        if !resolved.is_file() {
+            let problem = format!(
+                "material library '{name}' not found at {}",
+                resolved.display()
+            );
+            match options.missing_assets {
+                MissingAssets::Error => {
+                    return Err(Error::input_at(
+                        path,
+                        Location::Line(*line_no),
+                        problem,
+                        "put the .mtl file there, fix the mtllib line, or pass --missing-assets warn to use default materials",
+                    ));
+                }
+                MissingAssets::Warn => warnings.push(problem),
+            }
+        }
+        mtl_paths.insert(name.clone(), resolved);
+    }
+
+    let load_options = tobj::LoadOptions {
+        triangulate: true,
+        single_index: false,
+        ignore_points: true,
+        ignore_lines: true,
+    };
+    let mtl_error: std::cell::RefCell<Option<(PathBuf, tobj::LoadError)>> = Default::default();
+    let (models, materials) =
+        tobj::load_obj_buf(&mut Cursor::new(scan.text.as_bytes()), &load_options, |p| {
+            let name = p.to_string_lossy().to_string();
+            let resolved = mtl_paths.get(&name).cloned().unwrap_or_else(|| dir.join(p));
+            if !resolved.is_file() {
+                // Already reported (or warned about) above.
+                return Ok((Vec::new(), Default::default()));
+            }
+            let result = tobj::load_mtl(&resolved);
+            if let Err(e) = &result {
+                mtl_error.borrow_mut().get_or_insert((resolved, *e));
+            }
+            result
+        })
+        .map_err(|e| {
+            Error::input(
+                path,
+                format!("the OBJ parser rejected the file: {e}"),
+                FIX_SYNTAX,
+            )
+        })?;
+    if let Some((mtl, e)) = mtl_error.into_inner() {
+        return Err(Error::input(
+            &mtl,
+            format!("the material library is malformed: {e}"),
+            "fix or re-export the .mtl file",
+        ));
+    }
+    let tobj_materials = materials.unwrap_or_default();
+
+    // Materials and their textures (decoded once, shared).
+    let mut cache = TextureCache::default();
+    let mut out_materials = Vec::with_capacity(tobj_materials.len() + 1);
+    for m in &tobj_materials {
+        let mtl_dir = scan
+            .mtllibs
+            .iter()
+            .filter_map(|(_, n)| mtl_paths.get(n))
+            .find_map(|p| p.parent())
+            .unwrap_or(&dir)
+            .to_path_buf();
+        let mut mat = Material::default_material();
+        mat.name = m.name.clone();
+        if let Some(kd) = m.diffuse {
+            mat.base_color = Vec3::from(kd);
+        }
+        if let Some(ks) = m.specular {
+            mat.specular = Vec3::from(ks);
+        }
+        if let Some(ns) = m.shininess {
+            mat.shininess = ns.max(1.0);
+        }
+        let normal_name = m
+            .normal_texture
+            .clone()
+            .or_else(|| m.unknown_param.get("norm").cloned());
+        let wanted = [
+            (m.diffuse_texture.clone(), ColorSpace::Srgb),
+            (normal_name, ColorSpace::Linear),
+        ];
+        for (slot, (name, space)) in wanted.into_iter().enumerate() {
+            let Some(name) = name.filter(|n| !n.trim().is_empty()) else {
+                continue;
+            };
+            let tex_path = resolve_asset_path(&mtl_dir, &name);
+            let referrer = mtl_dir.join(format!("(material '{}')", m.name));
+            match cache.load(&tex_path, space, &referrer) {
+                Ok(t) if slot == 0 => mat.base_color_texture = Some(t),
+                Ok(t) => mat.normal_texture = Some(t),
+                Err(e) => match options.missing_assets {
+                    MissingAssets::Error => {
+                        return Err(Error::input_at(
+                            path,
+                            Location::Element(format!("material '{}'", m.name)),
+                            format!("texture problem: {e}"),
+                            "",
+                        ));
+                    }
+                    MissingAssets::Warn => warnings.push(format!("material '{}': {e}", m.name)),
+                },
+            }
+        }
+        out_materials.push(mat);
+    }
+    let default_id = out_materials.len() as u32;
+    let mut needs_default = false;
+
+    // Vertices: one per distinct (model, position, uv, normal) triple, in order of first use.
+    let mut positions = Vec::new();
+    let mut uvs = Vec::new();
+    let mut normals = Vec::new();
+    let mut colors = Vec::new();
+    // UVs: if any part has them, parts without get (0, 0); normals only if every part has them
+    // (otherwise all are computed, so shading is consistent across parts).
+    let has_uv = models.iter().any(|m| !m.mesh.texcoord_indices.is_empty());
+    let has_n = models.iter().all(|m| !m.mesh.normal_indices.is_empty()) && !models.is_empty();
+    let has_c = models.iter().all(|m| !m.mesh.vertex_color.is_empty()) && !models.is_empty();
+    let mut triangles = Vec::new();
+    let mut material_ids = Vec::new();
+    for model in &models {
+        let mesh = &model.mesh;
+        let mut seen: HashMap<(u32, u32, u32), u32> = HashMap::new();
+        let mat = match mesh.material_id {
+            Some(id) if id < out_materials.len() => id as u32,
+            _ => {
+                needs_default = true;
+                default_id
+            }
+        };
+        let corner = |c: usize| -> (u32, u32, u32) {
+            let p = mesh.indices[c];
+            let t = mesh.texcoord_indices.get(c).copied().unwrap_or(u32::MAX);
+            let n = if has_n { mesh.normal_indices[c] } else { 0 };
+            (p, t, n)
+        };
+        for tri in mesh.indices.chunks_exact(3).enumerate().map(|(t, _)| t) {
+            let mut out = [0u32; 3];
+            for (k, slot) in out.iter_mut().enumerate() {
+                let key = corner(tri * 3 + k);
+                *slot = *seen.entry(key).or_insert_with(|| {
+                    let (p, t, n) = (key.0 as usize, key.1 as usize, key.2 as usize);
+                    positions.push(Vec3::new(
+                        mesh.positions[3 * p],
+                        mesh.positions[3 * p + 1],
+                        mesh.positions[3 * p + 2],
+                    ));
+                    if has_uv {
+                        uvs.push(match key.1 {
+                            u32::MAX => Vec2::ZERO,
+                            _ => Vec2::new(mesh.texcoords[2 * t], mesh.texcoords[2 * t + 1]),
+                        });
+                    }
+                    if has_n {
+                        normals.push(Vec3::new(
+                            mesh.normals[3 * n],
+                            mesh.normals[3 * n + 1],
+                            mesh.normals[3 * n + 2],
+                        ));
+                    }
+                    if has_c {
+                        let c = &mesh.vertex_color[3 * p..3 * p + 3];
+                        colors.push(Vec3::new(
+                            srgb_to_linear(c[0]),
+                            srgb_to_linear(c[1]),
+                            srgb_to_linear(c[2]),
+                        ));
+                    }
+                    (positions.len() - 1) as u32
+                });
+            }
+            triangles.push(out);
+            material_ids.push(mat);
+        }
+    }
+    if needs_default {
+        out_materials.push(Material::default_material());
+    }
+    Ok(MeshData {
+        positions,
+        normals: has_n.then_some(normals),
+        uvs: has_uv.then_some(uvs),
+        colors: has_c.then_some(colors),
+        triangles,
+        material_ids,
+        materials: out_materials,
+        source: Source {
+            path: path.to_path_buf(),
+            format: Format::Obj,
+            file_vertices: scan.positions,
+            file_faces: scan.faces,
+        },
+        warnings,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn scan_moves_mtllib_first_and_keeps_line_count() {
+        let s = scan(Path::new("x.obj"), "v 0 0 0\nusemtl a\nmtllib m.mtl\n").unwrap();
+        assert!(s.text.starts_with("mtllib m.mtl\nv 0 0 0\nusemtl a\n"));
+        assert_eq!(s.mtllibs, vec![(3, "m.mtl".to_string())]);
+    }
+
+    #[test]
+    fn face_before_its_vertex_is_reported_with_its_line() {
+        let e = scan(Path::new("x.obj"), "v 0 0 0\nf 1 2 3\nv 1 0 0\nv 0 1 0\n").unwrap_err();
+        assert!(e.to_string().contains("line 2"), "{e}");
+    }
+
+    #[test]
+    fn negative_indices_are_relative() {
+        assert!(
+            scan(
+                Path::new("x.obj"),
+                "v 0 0 0\nv 1 0 0\nv 0 1 0\nf -3 -2 -1\n"
+            )
+            .is_ok()
+        );
+    }
+}

@@ -1,0 +1,220 @@
+//! Stanford PLY loader, ASCII and binary (parsing by `ply-rs-bw`).
+//!
+//! Reads the `vertex` element (`x y z`, optional `nx ny nz`, colour as `red green blue` or
+//! `diffuse_red …`, UVs as `u v`, `s t` or `texture_u texture_v`) and faces from a `face` element
+//! (`vertex_indices` or `vertex_index` lists, fan-triangulated) and/or a `tristrips` element
+//! (`vertex_indices` lists where −1 restarts the strip; Cyberware's Igea is stored this way).
+//!
+//! Decisions: strip triangles alternate winding as OpenGL's `GL_TRIANGLE_STRIP` does; strip
+//! triangles with a repeated index are the stitching between sub-strips and are dropped (they have
+//! no area), so they are not counted as degenerate. Integer colours are 8-bit sRGB; float colours
+//! are sRGB in 0..1; both are linearised.
+
+use std::path::Path;
+
+use glam::{Vec2, Vec3};
+use ply_rs_bw::parser::Parser;
+use ply_rs_bw::ply::{DefaultElement, Property};
+
+use super::{Format, MeshData, Source, read_file};
+use crate::error::{Error, Location, Result};
+use crate::metric::color::srgb_to_linear;
+
+const REEXPORT: &str = "re-export the PLY from its authoring tool";
+
+fn scalar(e: &DefaultElement, names: &[&str]) -> Option<f32> {
+    names
+        .iter()
+        .find_map(|n| e.get(*n))
+        .and_then(Property::to_f32_lossy)
+}
+
+fn color_channel(p: &Property) -> Option<f32> {
+    let v = match p {
+        Property::Float(f) => *f,
+        Property::Double(d) => *d as f32,
+        other => other.to_f32_lossy()? / 255.0,
+    };
+    Some(srgb_to_linear(v))
+}
+
+/// A list property as signed indices (strips use −1 as a restart marker).
+fn index_list(p: &Property) -> Option<Vec<i64>> {
+    Some(match p {
+        Property::ListChar(v) => v.iter().map(|&x| x as i64).collect(),
+        Property::ListUChar(v) => v.iter().map(|&x| x as i64).collect(),
+        Property::ListShort(v) => v.iter().map(|&x| x as i64).collect(),
+        Property::ListUShort(v) => v.iter().map(|&x| x as i64).collect(),
+        Property::ListInt(v) => v.iter().map(|&x| x as i64).collect(),
+        Property::ListUInt(v) => v.iter().map(|&x| x as i64).collect(),
+        _ => return None,
+    })
+}
+
+/// Load a PLY file.
+pub(crate) fn load(path: &Path) -> Result<MeshData> {
+    let bytes = read_file(path)?;
+    let parser = Parser::<DefaultElement>::new();
+    let ply = parser.read_ply(&mut bytes.as_slice()).map_err(|e| {
+        let loc = e.line().map(Location::Line);
+        let problem = format!("the file is not a valid PLY file: {e}");
+        match loc {
+            Some(l) => Error::input_at(path, l, problem, REEXPORT),
+            None => Error::input(
+                path,
+                problem,
+                "the file may be truncated; re-export or re-download it",
+            ),
+        }
+    })?;
+    let empty = Vec::new();
+    let vertices = ply.payload.get("vertex").unwrap_or(&empty);
+    if vertices.is_empty() {
+        return Err(Error::input(
+            path,
+            "the file has no 'vertex' element",
+            REEXPORT,
+        ));
+    }
+    let elem = |what: &str, i: usize| Location::Element(format!("{what} {i}"));
+
+    // Vertex attributes.
+    let first = &vertices[0];
+    let has_n = ["nx", "ny", "nz"].iter().all(|k| first.contains_key(*k));
+    let color_keys: Option<[&str; 3]> = [
+        ["red", "green", "blue"],
+        ["diffuse_red", "diffuse_green", "diffuse_blue"],
+        ["r", "g", "b"],
+    ]
+    .into_iter()
+    .find(|k| k.iter().all(|n| first.contains_key(*n)));
+    let uv_keys: Option<[&str; 2]> = [["u", "v"], ["s", "t"], ["texture_u", "texture_v"]]
+        .into_iter()
+        .find(|k| k.iter().all(|n| first.contains_key(*n)));
+    let mut positions = Vec::with_capacity(vertices.len());
+    let mut normals = Vec::new();
+    let mut colors = Vec::new();
+    let mut uvs = Vec::new();
+    for (i, v) in vertices.iter().enumerate() {
+        let get = |k: &str| {
+            scalar(v, &[k]).ok_or_else(|| {
+                Error::input_at(
+                    path,
+                    elem("vertex", i),
+                    format!("property '{k}' is missing or not a number"),
+                    REEXPORT,
+                )
+            })
+        };
+        positions.push(Vec3::new(get("x")?, get("y")?, get("z")?));
+        if has_n {
+            normals.push(Vec3::new(get("nx")?, get("ny")?, get("nz")?));
+        }
+        if let Some(keys) = color_keys {
+            let c = keys.map(|k| v.get(k).and_then(color_channel).unwrap_or(1.0));
+            colors.push(Vec3::from(c));
+        }
+        if let Some([u, w]) = uv_keys {
+            uvs.push(Vec2::new(get(u)?, get(w)?));
+        }
+    }
+
+    // Faces as polygon lists and as triangle strips.
+    let n = positions.len() as i64;
+    let mut triangles = Vec::new();
+    let mut file_faces = 0;
+    let check = |what: &str, i: usize, idx: i64| -> Result<u32> {
+        if idx < 0 || idx >= n {
+            return Err(Error::input_at(
+                path,
+                elem(what, i),
+                format!("vertex index {idx} is out of range (the file has {n} vertices)"),
+                REEXPORT,
+            ));
+        }
+        Ok(idx as u32)
+    };
+    for (i, f) in ply.payload.get("face").unwrap_or(&empty).iter().enumerate() {
+        let list = ["vertex_indices", "vertex_index"]
+            .iter()
+            .find_map(|k| f.get(*k))
+            .and_then(index_list)
+            .ok_or_else(|| {
+                Error::input_at(
+                    path,
+                    elem("face", i),
+                    "has no 'vertex_indices' list",
+                    REEXPORT,
+                )
+            })?;
+        if list.len() < 3 {
+            return Err(Error::input_at(
+                path,
+                elem("face", i),
+                format!("has {} vertices; a face needs at least 3", list.len()),
+                REEXPORT,
+            ));
+        }
+        let idx: Vec<u32> = list
+            .iter()
+            .map(|&x| check("face", i, x))
+            .collect::<Result<_>>()?;
+        for k in 1..idx.len() - 1 {
+            triangles.push([idx[0], idx[k], idx[k + 1]]);
+        }
+        file_faces += 1;
+    }
+    for (i, s) in ply
+        .payload
+        .get("tristrips")
+        .unwrap_or(&empty)
+        .iter()
+        .enumerate()
+    {
+        let list = s
+            .get("vertex_indices")
+            .and_then(index_list)
+            .ok_or_else(|| {
+                Error::input_at(
+                    path,
+                    elem("tristrips", i),
+                    "has no 'vertex_indices' list",
+                    REEXPORT,
+                )
+            })?;
+        for strip in list.split(|&x| x == -1) {
+            let idx: Vec<u32> = strip
+                .iter()
+                .map(|&x| check("tristrips", i, x))
+                .collect::<Result<_>>()?;
+            for k in 0..idx.len().saturating_sub(2) {
+                let t = if k % 2 == 0 {
+                    [idx[k], idx[k + 1], idx[k + 2]]
+                } else {
+                    [idx[k + 1], idx[k], idx[k + 2]]
+                };
+                if t[0] != t[1] && t[1] != t[2] && t[0] != t[2] {
+                    triangles.push(t);
+                    file_faces += 1;
+                }
+            }
+        }
+    }
+
+    Ok(MeshData {
+        positions,
+        normals: has_n.then_some(normals),
+        uvs: uv_keys.map(|_| uvs),
+        colors: color_keys.map(|_| colors),
+        triangles,
+        material_ids: vec![],
+        materials: vec![],
+        source: Source {
+            path: path.to_path_buf(),
+            format: Format::Ply,
+            file_vertices: vertices.len(),
+            file_faces,
+        },
+        warnings: vec![],
+    })
+}

@@ -1,0 +1,199 @@
+//! Decoded texture images and the shared texture cache used by the loaders.
+//!
+//! A texture is decoded once and shared by `Arc` between every material that names the same file
+//! (DESIGN.md: "textures decoded once, Arc-shared"). Pixels stay 8-bit RGBA with their colour space
+//! tagged; linearisation belongs to the renderer's mip-pyramid build (`raster/texture.rs`).
+//!
+//! Decision: texture file names from MTL files are resolved relative to the MTL file, with
+//! Windows separators (`.\tex.jpg`) accepted and, when the exact name is absent, a file differing
+//! only in letter case accepted too (assets authored on Windows often disagree on case).
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+use crate::error::{Error, Result};
+
+/// How a texture's 8-bit values encode light.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum ColorSpace {
+    /// sRGB-encoded colour (base-colour / albedo textures).
+    Srgb,
+    /// Linear data (normal maps).
+    Linear,
+}
+
+/// A decoded texture.
+///
+/// # Guarantees
+/// - `width() >= 1`, `height() >= 1`, and `rgba().len() == 4 * width * height`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Texture {
+    label: String,
+    width: u32,
+    height: u32,
+    rgba: Vec<u8>,
+    space: ColorSpace,
+}
+
+impl Texture {
+    /// A texture from RGBA8 pixels in row-major order, top row first; `None` if the sizes disagree
+    /// or either dimension is zero.
+    pub fn new(
+        label: String,
+        width: u32,
+        height: u32,
+        rgba: Vec<u8>,
+        space: ColorSpace,
+    ) -> Option<Texture> {
+        let expected = (width as usize)
+            .checked_mul(height as usize)?
+            .checked_mul(4)?;
+        (width >= 1 && height >= 1 && rgba.len() == expected).then_some(Texture {
+            label,
+            width,
+            height,
+            rgba,
+            space,
+        })
+    }
+
+    /// Where the texture came from (a path, or a glTF image index).
+    pub fn label(&self) -> &str {
+        &self.label
+    }
+    /// Width in texels.
+    pub fn width(&self) -> u32 {
+        self.width
+    }
+    /// Height in texels.
+    pub fn height(&self) -> u32 {
+        self.height
+    }
+    /// RGBA8 texels, row-major, top row first.
+    pub fn rgba(&self) -> &[u8] {
+        &self.rgba
+    }
+    /// Colour space of the stored values.
+    pub fn color_space(&self) -> ColorSpace {
+        self.space
+    }
+
+    /// Decode an in-memory image (PNG or JPEG).
+    pub fn decode(
+        label: &str,
+        bytes: &[u8],
+        space: ColorSpace,
+    ) -> std::result::Result<Texture, String> {
+        let img = image::load_from_memory(bytes).map_err(|e| e.to_string())?;
+        Texture::from_image(label, img, space)
+    }
+
+    /// Convert a decoded `image` into a texture.
+    pub fn from_image(
+        label: &str,
+        img: image::DynamicImage,
+        space: ColorSpace,
+    ) -> std::result::Result<Texture, String> {
+        let rgba = img.into_rgba8();
+        let (w, h) = rgba.dimensions();
+        Texture::new(label.to_string(), w, h, rgba.into_raw(), space)
+            .ok_or_else(|| format!("the image has zero size ({w}x{h})"))
+    }
+}
+
+/// Textures already decoded during one load, keyed by resolved path and colour space.
+#[derive(Debug, Default)]
+pub(crate) struct TextureCache {
+    decoded: BTreeMap<(PathBuf, bool), Arc<Texture>>,
+}
+
+impl TextureCache {
+    /// Decode the image at `path` once; later calls return the same `Arc`.
+    /// `referrer` is the file that named the texture, for the error message.
+    pub fn load(
+        &mut self,
+        path: &Path,
+        space: ColorSpace,
+        referrer: &Path,
+    ) -> Result<Arc<Texture>> {
+        let key = (path.to_path_buf(), space == ColorSpace::Srgb);
+        if let Some(t) = self.decoded.get(&key) {
+            return Ok(t.clone());
+        }
+        let bytes = std::fs::read(path).map_err(|e| {
+            Error::input(
+                referrer,
+                format!("texture '{}' cannot be read: {e}", path.display()),
+                "put the image there, fix the path in the file, or pass --missing-assets warn to render with the base colour",
+            )
+        })?;
+        let tex = Texture::decode(&path.display().to_string(), &bytes, space).map_err(|e| {
+            Error::input(
+                path,
+                format!("texture cannot be decoded: {e}"),
+                "re-save it as PNG or JPEG, or pass --missing-assets warn to render with the base colour",
+            )
+        })?;
+        let tex = Arc::new(tex);
+        self.decoded.insert(key, tex.clone());
+        Ok(tex)
+    }
+}
+
+/// Resolve a texture or library name written in a file: Windows separators become `/`, map
+/// options (`-bm 0.5 file.png`) are skipped, and the result is relative to `base_dir`. If the exact
+/// file does not exist but one differing only in letter case does, that one is returned.
+pub(crate) fn resolve_asset_path(base_dir: &Path, written: &str) -> PathBuf {
+    let mut name = written.trim();
+    if name.starts_with('-') {
+        // MTL map statements may carry options before the file name; the name is the last token.
+        name = name.split_whitespace().last().unwrap_or(name);
+    }
+    let normalized = name.replace('\\', "/");
+    let rel = normalized.trim_start_matches("./");
+    let candidate = base_dir.join(rel);
+    if candidate.exists() {
+        return candidate;
+    }
+    if let (Some(parent), Some(file)) = (candidate.parent(), candidate.file_name()) {
+        if let Ok(entries) = std::fs::read_dir(parent) {
+            let mut matches: Vec<PathBuf> = entries
+                .filter_map(|e| e.ok())
+                .filter(|e| e.file_name().eq_ignore_ascii_case(file))
+                .map(|e| e.path())
+                .collect();
+            matches.sort();
+            if let Some(first) = matches.into_iter().next() {
+                return first;
+            }
+        }
+    }
+    candidate
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn zero_size_texture_is_rejected() {
+        assert!(Texture::new("x".into(), 0, 4, vec![], ColorSpace::Srgb).is_none());
+        assert!(Texture::new("x".into(), 2, 2, vec![0; 15], ColorSpace::Srgb).is_none());
+        assert!(Texture::new("x".into(), 2, 2, vec![0; 16], ColorSpace::Srgb).is_some());
+    }
+
+    #[test]
+    fn windows_paths_and_options_resolve() {
+        let dir = Path::new("/nonexistent-dir");
+        assert_eq!(
+            resolve_asset_path(dir, ".\\SpiderTex.jpg"),
+            dir.join("SpiderTex.jpg")
+        );
+        assert_eq!(
+            resolve_asset_path(dir, "-bm 0.5 tex\\n.png"),
+            dir.join("tex/n.png")
+        );
+    }
+}
