@@ -106,6 +106,8 @@ impl fmt::Display for Error {
                 if let Some(loc) = location {
                     write!(f, ", {loc}")?;
                 }
+                // One message, one line: parser messages sometimes carry their own line breaks.
+                let problem: String = problem.split_whitespace().collect::<Vec<_>>().join(" ");
                 write!(f, ": {problem}")?;
                 if !fix.is_empty() {
                     write!(f, "; {fix}")?;

@@ -78,9 +78,28 @@ fn rgba8_from(data: gltf::image::Data) -> std::result::Result<(u32, u32, Vec<u8>
 /// Load a glTF or GLB file.
 pub(crate) fn load(path: &Path, options: &LoadOptions) -> Result<MeshData> {
     let bytes = read_file(path)?;
-    let gltf::Gltf { document, blob } = gltf::Gltf::from_slice(&bytes)
-        .map_err(|e| Error::input(path, format!("not a valid glTF file: {e}"), REEXPORT))?;
+    let invalid =
+        |e: gltf::Error| Error::input(path, format!("not a valid glTF file: {e}"), REEXPORT);
+    let gltf::Gltf { document, blob } =
+        gltf::Gltf::from_slice_without_validation(&bytes).map_err(invalid)?;
+    let root = document.into_json();
+    check_primitive_accessors(path, &root)?;
+    let document = gltf::Document::from_json(root).map_err(invalid)?;
     let base = path.parent().unwrap_or(Path::new("."));
+    // Name a missing external buffer ourselves; the import error would only say "not found".
+    for buffer in document.buffers() {
+        if let gltf::buffer::Source::Uri(uri) = buffer.source() {
+            let file = base.join(uri);
+            if !uri.starts_with("data:") && !uri.contains('%') && !file.is_file() {
+                return Err(Error::input_at(
+                    path,
+                    Location::Element(format!("buffer {}", buffer.index())),
+                    format!("its data file '{uri}' is missing"),
+                    "put the .bin file next to the .gltf, or re-export as a single .glb",
+                ));
+            }
+        }
+    }
     let buffers = gltf::import_buffers(&document, Some(base), blob).map_err(|e| {
         Error::input(
             path,
@@ -200,7 +219,7 @@ pub(crate) fn load(path: &Path, options: &LoadOptions) -> Result<MeshData> {
             stack.push((child, world));
         }
     }
-    if b.material_ids.iter().any(|&m| m == default_id) {
+    if b.material_ids.contains(&default_id) {
         materials.push(Material::default_material());
     }
     warnings.append(&mut b.warnings);
@@ -221,9 +240,67 @@ pub(crate) fn load(path: &Path, options: &LoadOptions) -> Result<MeshData> {
             format: Format::Gltf,
             file_vertices: b.file_vertices,
             file_faces,
+            file_unreferenced: 0,
         },
         warnings,
     })
+}
+
+/// Check that every primitive names accessors that exist and have types lodeval reads. The `gltf`
+/// crate panics on both kinds of file (found by the fuzz tests): its validation indexes the POSITION
+/// accessor before checking it exists, and its readers hit `unreachable!` on an index or attribute
+/// accessor of a component type the specification does not allow there. So this runs first.
+fn check_primitive_accessors(path: &Path, root: &gltf::json::Root) -> Result<()> {
+    use gltf::json::accessor::{ComponentType as C, Type as T};
+    use gltf::json::mesh::Semantic as S;
+    use gltf::json::validation::Checked;
+    let count = root.accessors.len();
+    for (mi, mesh) in root.meshes.iter().enumerate() {
+        for (pi, prim) in mesh.primitives.iter().enumerate() {
+            let here = || Location::Element(format!("mesh {mi} primitive {pi}"));
+            let attributes = prim.attributes.iter().map(|(s, a)| (Some(s), a));
+            for (semantic, accessor) in attributes.chain(prim.indices.iter().map(|a| (None, a))) {
+                let Some(acc) = root.accessors.get(accessor.value()) else {
+                    return Err(Error::input_at(
+                        path,
+                        here(),
+                        format!(
+                            "refers to accessor {}, but the file has {count} accessors",
+                            accessor.value()
+                        ),
+                        REEXPORT,
+                    ));
+                };
+                let (Checked::Valid(ty), Checked::Valid(ct)) = (&acc.type_, &acc.component_type)
+                else {
+                    continue; // reported by the validation that follows
+                };
+                let allowed: (&[T], &[C]) = match semantic {
+                    None => (&[T::Scalar], &[C::U8, C::U16, C::U32]),
+                    Some(Checked::Valid(S::Positions | S::Normals)) => (&[T::Vec3], &[C::F32]),
+                    Some(Checked::Valid(S::TexCoords(_))) => (&[T::Vec2], &[C::F32, C::U8, C::U16]),
+                    Some(Checked::Valid(S::Colors(_))) => {
+                        (&[T::Vec3, T::Vec4], &[C::F32, C::U8, C::U16])
+                    }
+                    _ => continue, // attributes lodeval does not read
+                };
+                if !allowed.0.contains(ty) || !allowed.1.contains(&ct.0) {
+                    let what = semantic.map_or("indices".to_string(), |s| format!("{s:?}"));
+                    return Err(Error::input_at(
+                        path,
+                        here(),
+                        format!(
+                            "{what} accessor {} has type {ty:?} of {:?}, which glTF does not allow there",
+                            accessor.value(),
+                            ct.0
+                        ),
+                        REEXPORT,
+                    ));
+                }
+            }
+        }
+    }
+    Ok(())
 }
 
 fn add_mesh(

@@ -162,6 +162,9 @@ pub struct Source {
     pub file_vertices: usize,
     /// Face records in the file (polygons, strips count as their triangles).
     pub file_faces: usize,
+    /// Vertex records no face uses, where the loader dropped them before [`Mesh::new`] could
+    /// count them (OBJ); [`Mesh::unreferenced_removed`] adds the ones dropped later.
+    pub file_unreferenced: usize,
 }
 
 /// A mesh as a loader produced it, before validation. Every field is plain data; [`Mesh::new`]
@@ -230,7 +233,8 @@ impl Mesh {
             data.material_ids = vec![0; data.triangles.len()];
         }
         // Drop vertices no triangle uses, so every later stage can rely on "every vertex is used".
-        let unreferenced_removed = validate::compact_unreferenced(&mut data);
+        let unreferenced_removed =
+            validate::compact_unreferenced(&mut data) + data.source.file_unreferenced;
         // Normals: keep the file's (normalised), or compute angle-weighted ones with creases.
         let normals_from_file = data.normals.is_some();
         let normals = match data.normals.take() {
@@ -313,7 +317,7 @@ impl Mesh {
     pub fn normals_from_file(&self) -> bool {
         self.normals_from_file
     }
-    /// Vertices in the loaded data that no triangle used (dropped).
+    /// Vertex records of the file that no triangle used (dropped).
     pub fn unreferenced_removed(&self) -> usize {
         self.unreferenced_removed
     }
@@ -341,6 +345,22 @@ impl Mesh {
 /// A loader crate that panics on malformed data is caught and reported the same way, so bad input
 /// never aborts the process.
 pub fn load(path: &Path, options: &LoadOptions) -> Result<Mesh> {
+    match std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+        load_unguarded(path, options)
+    })) {
+        Ok(result) => result,
+        Err(_) => Err(Error::input(
+            path,
+            "the file is malformed (the parser gave up on it)",
+            "re-export the file from its authoring tool",
+        )),
+    }
+}
+
+/// [`load`] without the panic guard. Exists for the fuzz tests, which must see a panic in our code
+/// or a parser crate as the bug it is rather than as a handled error.
+#[doc(hidden)]
+pub fn load_unguarded(path: &Path, options: &LoadOptions) -> Result<Mesh> {
     let format = Format::from_path(path)?;
     if !path.exists() {
         return Err(Error::input(
@@ -356,24 +376,12 @@ pub fn load(path: &Path, options: &LoadOptions) -> Result<Mesh> {
             "name a mesh file",
         ));
     }
-    let run = || -> Result<MeshData> {
-        match format {
-            Format::Obj => obj::load(path, options),
-            Format::Ply => ply::load(path),
-            Format::Gltf => gltf::load(path, options),
-            Format::Off => off::load(path),
-        }
-    };
-    let data = match std::panic::catch_unwind(std::panic::AssertUnwindSafe(run)) {
-        Ok(result) => result?,
-        Err(_) => {
-            return Err(Error::input(
-                path,
-                "the file is malformed (the parser gave up on it)",
-                "re-export the file from its authoring tool",
-            ));
-        }
-    };
+    let data = match format {
+        Format::Obj => obj::load(path, options),
+        Format::Ply => ply::load(path),
+        Format::Gltf => gltf::load(path, options),
+        Format::Off => off::load(path),
+    }?;
     Mesh::new(data, options)
 }
 

@@ -161,6 +161,7 @@ pub(crate) fn normalize_given(
                 format: super::Format::Obj,
                 file_vertices: 0,
                 file_faces: 0,
+                file_unreferenced: 0,
             },
             warnings: vec![],
         };
@@ -193,6 +194,7 @@ mod tests {
                 format: Format::Obj,
                 file_vertices: 4,
                 file_faces: 3,
+                file_unreferenced: 0,
             },
             warnings: vec![],
         }
@@ -210,10 +212,11 @@ mod tests {
 
     #[test]
     fn crease_splits_the_corner_into_three_flat_normals() {
-        // The faces meet at 90°, above a 60° crease, so the origin gets one copy per face.
+        // The faces meet at 90°, above a 60° crease, so the origin gets one copy per face (3) and
+        // X, Y and Z, each shared by two faces, get two copies: 3 + 3·2 = 9 vertices.
         let mut m = cube_corner();
         let n = generate(&mut m, 60.0);
-        assert_eq!(m.positions.len(), 6);
+        assert_eq!(m.positions.len(), 9);
         let origin_normals: Vec<Vec3> = m.triangles.iter().map(|t| n[t[0] as usize]).collect();
         assert_eq!(origin_normals, vec![-Vec3::Z, -Vec3::Y, -Vec3::X]);
     }

@@ -25,8 +25,12 @@ use crate::metric::color::srgb_to_linear;
 const FIX_SYNTAX: &str = "fix or delete that line, or re-export the OBJ";
 
 /// What the line scan found.
+#[derive(Debug)]
 struct Scan {
     positions: usize,
+    unreferenced: usize,
+    /// Vertex colours were given on some `v` lines but not all, and were dropped.
+    partial_colors: bool,
     faces: usize,
     mtllibs: Vec<(usize, String)>,
     /// The text with every `mtllib`, `l` and `p` line blanked and the `mtllib` lines prepended.
@@ -34,10 +38,10 @@ struct Scan {
 }
 
 /// Parse `count` floats from the tokens, or say which line is wrong.
-fn floats(
+fn floats<'a>(
     path: &Path,
     line_no: usize,
-    tokens: &mut std::str::SplitWhitespace<'_>,
+    tokens: &mut impl Iterator<Item = &'a str>,
     count: usize,
     what: &str,
 ) -> Result<[f32; 3]> {
@@ -72,8 +76,18 @@ fn floats(
 }
 
 /// Check one face-vertex token `p[/t[/n]]` against the records defined so far.
-fn face_ref(path: &Path, line_no: usize, tok: &str, counts: [usize; 3]) -> Result<()> {
-    const NAMES: [&str; 3] = ["vertex", "texture coordinate", "normal"];
+fn face_ref(
+    path: &Path,
+    line_no: usize,
+    tok: &str,
+    counts: [usize; 3],
+    referenced: &mut [bool],
+) -> Result<()> {
+    const NAMES: [(&str, &str); 3] = [
+        ("vertex", "vertices"),
+        ("texture coordinate", "texture coordinates"),
+        ("normal", "normals"),
+    ];
     for (slot, part) in tok.split('/').enumerate().take(3) {
         if part.is_empty() && slot > 0 {
             continue;
@@ -93,11 +107,14 @@ fn face_ref(path: &Path, line_no: usize, tok: &str, counts: [usize; 3]) -> Resul
                 path,
                 Location::Line(line_no),
                 format!(
-                    "face refers to {} {idx}, but only {n} {}s are defined before this line",
-                    NAMES[slot], NAMES[slot]
+                    "face refers to {} {idx}, but only {n} {} are defined before this line",
+                    NAMES[slot].0, NAMES[slot].1
                 ),
                 "fix the face indices (OBJ indices start at 1) or add the missing records",
             ));
+        }
+        if slot == 0 {
+            referenced[resolved as usize - 1] = true;
         }
     }
     Ok(())
@@ -106,6 +123,8 @@ fn face_ref(path: &Path, line_no: usize, tok: &str, counts: [usize; 3]) -> Resul
 fn scan(path: &Path, text: &str) -> Result<Scan> {
     let mut counts = [0usize; 3];
     let mut faces = 0;
+    let mut colored = 0;
+    let mut referenced: Vec<bool> = Vec::new();
     let mut mtllibs = Vec::new();
     let mut body = String::with_capacity(text.len() + 64);
     for (i, raw) in text.split('\n').enumerate() {
@@ -115,7 +134,46 @@ fn scan(path: &Path, text: &str) -> Result<Scan> {
         let keep = match tokens.next() {
             Some("v") => {
                 floats(path, line_no, &mut tokens, 3, "vertex")?;
+                // After x y z: nothing, a weight w (x y z are divided by it), or an RGB colour.
+                let rest: Vec<&str> = tokens.collect();
+                match rest.len() {
+                    0 => {}
+                    1 if rest[0]
+                        .parse::<f32>()
+                        .map_or(true, |w| w == 0.0 || !w.is_finite()) =>
+                    {
+                        return Err(Error::input_at(
+                            path,
+                            Location::Line(line_no),
+                            format!("vertex weight w = '{}' must be a non-zero number", rest[0]),
+                            FIX_SYNTAX,
+                        ));
+                    }
+                    1 => {}
+                    3 => {
+                        floats(
+                            path,
+                            line_no,
+                            &mut line.split_whitespace().skip(4),
+                            3,
+                            "vertex colour",
+                        )?;
+                        colored += 1;
+                    }
+                    n => {
+                        return Err(Error::input_at(
+                            path,
+                            Location::Line(line_no),
+                            format!(
+                                "vertex record has {} numbers; expected 3 (x y z), 4 (x y z w) or 6 (x y z r g b)",
+                                n + 3
+                            ),
+                            FIX_SYNTAX,
+                        ));
+                    }
+                }
                 counts[0] += 1;
+                referenced.push(false);
                 true
             }
             Some("vt") => {
@@ -131,7 +189,7 @@ fn scan(path: &Path, text: &str) -> Result<Scan> {
             Some("f") => {
                 let mut corners = 0;
                 for tok in tokens {
-                    face_ref(path, line_no, tok, counts)?;
+                    face_ref(path, line_no, tok, counts, &mut referenced)?;
                     corners += 1;
                 }
                 if corners < 3 {
@@ -159,6 +217,22 @@ fn scan(path: &Path, text: &str) -> Result<Scan> {
         }
         body.push('\n');
     }
+    // tobj needs colours on every vertex or none; with only some, drop them all (and say so).
+    let partial_colors = colored > 0 && colored < counts[0];
+    if partial_colors {
+        body = body
+            .split('\n')
+            .map(|l| {
+                let t: Vec<&str> = l.split_whitespace().collect();
+                if t.first() == Some(&"v") && t.len() == 7 {
+                    t[..4].join(" ")
+                } else {
+                    l.to_string()
+                }
+            })
+            .collect::<Vec<_>>()
+            .join("\n");
+    }
     let mut text = String::with_capacity(body.len() + 64);
     for (_, name) in &mtllibs {
         text.push_str("mtllib ");
@@ -168,10 +242,41 @@ fn scan(path: &Path, text: &str) -> Result<Scan> {
     text.push_str(&body);
     Ok(Scan {
         positions: counts[0],
+        unreferenced: referenced.iter().filter(|&&r| !r).count(),
+        partial_colors,
         faces,
         mtllibs,
         text,
     })
+}
+
+/// Check the numeric statements of an MTL file with line numbers. `tobj` reports these only by
+/// kind, and panics on a colour with fewer than three numbers (found by the fuzz tests).
+fn check_mtl(path: &Path) -> Result<()> {
+    let text = String::from_utf8_lossy(&read_file(path)?).into_owned();
+    for (i, line) in text.split('\n').enumerate() {
+        let mut tokens = line.split_whitespace();
+        let (count, what) = match tokens.next() {
+            Some("Ka" | "Kd" | "Ks" | "Ke") => (3, "colour"),
+            Some("Ns" | "Ni" | "d" | "Tr") => (1, "material value"),
+            _ => continue,
+        };
+        floats(path, i + 1, &mut tokens, count, what).map_err(|e| match e {
+            Error::Input {
+                path,
+                location,
+                problem,
+                ..
+            } => Error::Input {
+                path,
+                location,
+                problem,
+                fix: "fix that line of the .mtl file or re-export it".into(),
+            },
+            other => other,
+        })?;
+    }
+    Ok(())
 }
 
 /// Load an OBJ file and the MTL libraries and textures it names.
@@ -190,6 +295,9 @@ pub(crate) fn load(path: &Path, options: &LoadOptions) -> Result<MeshData> {
     let scan = scan(path, &text)?;
     let dir = path.parent().unwrap_or(Path::new(".")).to_path_buf();
     let mut warnings = Vec::new();
+    if scan.partial_colors {
+        warnings.push("vertex colours are given for only some vertices; all were ignored".into());
+    }
 
     // Material libraries: a missing one is an error unless the user asked for warnings.
     let mut mtl_paths: HashMap<String, PathBuf> = HashMap::new();
@@ -211,6 +319,9 @@ pub(crate) fn load(path: &Path, options: &LoadOptions) -> Result<MeshData> {
                 }
                 MissingAssets::Warn => warnings.push(problem),
             }
+        }
+        if resolved.is_file() {
+            check_mtl(&resolved)?;
         }
         mtl_paths.insert(name.clone(), resolved);
     }
@@ -392,6 +503,7 @@ pub(crate) fn load(path: &Path, options: &LoadOptions) -> Result<MeshData> {
             format: Format::Obj,
             file_vertices: scan.positions,
             file_faces: scan.faces,
+            file_unreferenced: scan.unreferenced,
         },
         warnings,
     })

@@ -164,6 +164,7 @@ pub(crate) fn load(path: &Path) -> Result<MeshData> {
             format: Format::Off,
             file_vertices: nv,
             file_faces: nf,
+            file_unreferenced: 0,
         },
         warnings: vec![],
     })

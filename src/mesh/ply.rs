@@ -57,7 +57,13 @@ pub(crate) fn load(path: &Path) -> Result<MeshData> {
     let parser = Parser::<DefaultElement>::new();
     let ply = parser.read_ply(&mut bytes.as_slice()).map_err(|e| {
         let loc = e.line().map(Location::Line);
-        let problem = format!("the file is not a valid PLY file: {e}");
+        // The parser's message starts with its own "Line N: "; we print the line once.
+        let text = e.to_string();
+        let text = match (e.line(), text.split_once(": ")) {
+            (Some(_), Some((head, rest))) if head.starts_with("Line ") => rest.to_string(),
+            _ => text,
+        };
+        let problem = format!("the file is not a valid PLY file: {text}");
         match loc {
             Some(l) => Error::input_at(path, l, problem, REEXPORT),
             None => Error::input(
@@ -214,6 +220,7 @@ pub(crate) fn load(path: &Path) -> Result<MeshData> {
             format: Format::Ply,
             file_vertices: vertices.len(),
             file_faces,
+            file_unreferenced: 0,
         },
         warnings: vec![],
     })

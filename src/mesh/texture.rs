@@ -157,18 +157,21 @@ pub(crate) fn resolve_asset_path(base_dir: &Path, written: &str) -> PathBuf {
     if candidate.exists() {
         return candidate;
     }
-    if let (Some(parent), Some(file)) = (candidate.parent(), candidate.file_name()) {
-        if let Ok(entries) = std::fs::read_dir(parent) {
-            let mut matches: Vec<PathBuf> = entries
-                .filter_map(|e| e.ok())
-                .filter(|e| e.file_name().eq_ignore_ascii_case(file))
-                .map(|e| e.path())
-                .collect();
-            matches.sort();
-            if let Some(first) = matches.into_iter().next() {
-                return first;
-            }
-        }
+    let (Some(parent), Some(file)) = (candidate.parent(), candidate.file_name()) else {
+        return candidate;
+    };
+    let Ok(entries) = std::fs::read_dir(parent) else {
+        return candidate;
+    };
+    let mut matches: Vec<PathBuf> = entries
+        .filter_map(|e| e.ok())
+        .filter(|e| e.file_name().eq_ignore_ascii_case(file))
+        .map(|e| e.path())
+        .collect();
+    // Sorted, so the choice does not depend on directory order.
+    matches.sort();
+    if let Some(first) = matches.into_iter().next() {
+        return first;
     }
     candidate
 }

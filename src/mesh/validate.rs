@@ -60,49 +60,34 @@ pub(crate) fn check(data: &MeshData) -> Result<Report> {
         ));
     }
     // Every coordinate and attribute must be finite.
-    if let Some(v) = data.positions.iter().position(|p| !p.is_finite()) {
-        return Err(Error::input_at(
+    let non_finite = |what: &str, v: usize, value: String, fix: &str| {
+        Err(Error::input_at(
             path,
             Location::Element(format!("vertex {v}")),
-            format!(
-                "position {} is not a finite number",
-                fmt_vec(data.positions[v])
-            ),
+            format!("{what} {value} is not a finite number"),
+            fix,
+        ))
+    };
+    if let Some(v) = data.positions.iter().position(|p| !p.is_finite()) {
+        return non_finite("position", v, fmt_vec(data.positions[v]), REEXPORT);
+    }
+    let normals = data.normals.as_deref().unwrap_or_default();
+    if let Some(v) = normals.iter().position(|p| !p.is_finite()) {
+        let fix = "remove the normals to let lodeval compute them, or re-export the mesh";
+        return non_finite("normal", v, fmt_vec(normals[v]), fix);
+    }
+    let uvs = data.uvs.as_deref().unwrap_or_default();
+    if let Some(v) = uvs.iter().position(|p| !p.is_finite()) {
+        return non_finite(
+            "texture coordinate",
+            v,
+            format!("({}, {})", uvs[v].x, uvs[v].y),
             REEXPORT,
-        ));
+        );
     }
-    if let Some(normals) = &data.normals {
-        if let Some(v) = normals.iter().position(|p| !p.is_finite()) {
-            return Err(Error::input_at(
-                path,
-                Location::Element(format!("vertex {v}")),
-                format!("normal {} is not a finite number", fmt_vec(normals[v])),
-                "remove the normals to let lodeval compute them, or re-export the mesh",
-            ));
-        }
-    }
-    if let Some(uvs) = &data.uvs {
-        if let Some(v) = uvs.iter().position(|p| !p.is_finite()) {
-            return Err(Error::input_at(
-                path,
-                Location::Element(format!("vertex {v}")),
-                format!(
-                    "texture coordinate ({}, {}) is not a finite number",
-                    uvs[v].x, uvs[v].y
-                ),
-                REEXPORT,
-            ));
-        }
-    }
-    if let Some(colors) = &data.colors {
-        if let Some(v) = colors.iter().position(|p| !p.is_finite()) {
-            return Err(Error::input_at(
-                path,
-                Location::Element(format!("vertex {v}")),
-                format!("colour {} is not a finite number", fmt_vec(colors[v])),
-                REEXPORT,
-            ));
-        }
+    let colors = data.colors.as_deref().unwrap_or_default();
+    if let Some(v) = colors.iter().position(|p| !p.is_finite()) {
+        return non_finite("colour", v, fmt_vec(colors[v]), REEXPORT);
     }
     // Indices in range; count zero-area triangles.
     let mut degenerate = 0;
@@ -221,6 +206,7 @@ mod tests {
                 format: Format::Obj,
                 file_vertices: 4,
                 file_faces: 4,
+                file_unreferenced: 0,
             },
             warnings: vec![],
         }

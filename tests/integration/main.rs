@@ -1,0 +1,14 @@
+//! lodeval's integration tests, compiled as one binary (ripgrep's habit). One module per area:
+//!
+//! - `cli`: the command line end to end (exit codes, output shapes, subcommands not built yet).
+//! - `bad_input`: crafted broken files across the formats; each must exit 2 with a message naming
+//!   the file and the problem, and never panic.
+//! - `models`: `lodeval info` on every model of the shared collection against MANIFEST.md's counts
+//!   (skipped only when `../shared` is absent) and on the shipped `reference/models`.
+//! - `fuzz`: property-based mutation fuzzing of the OBJ, PLY and OFF paths.
+
+mod bad_input;
+mod cli;
+mod common;
+mod fuzz;
+mod models;
