@@ -22,9 +22,13 @@
 
 #![warn(missing_docs, missing_debug_implementations)]
 
+pub mod commands;
 pub mod error;
+pub mod io;
 pub mod mesh;
 pub mod metric;
+pub mod raster;
+pub mod scene;
 
 pub use error::{Error, Location, Result};
 pub use mesh::{LoadOptions, Mesh, MeshSummary, MissingAssets};

@@ -7,6 +7,9 @@ use std::process::ExitCode;
 use std::sync::Mutex;
 
 use clap::{Args, Parser, Subcommand, ValueEnum};
+use lodeval::commands::{RenderJob, ViewSelection};
+use lodeval::raster::{RenderSettings, SamplePattern, Shading};
+use lodeval::scene::Rig;
 use lodeval::{Error, LoadOptions, MeshSummary, MissingAssets};
 
 #[derive(Parser, Debug)]
@@ -30,8 +33,8 @@ struct Cli {
 enum Command {
     /// Print what a mesh file contains: counts, attributes, materials, textures, bounds.
     Info(InfoArgs),
-    /// Render a mesh from the view rig (not built yet).
-    Render(NotYet),
+    /// Render a mesh from the views of a rig with the CPU rasterizer.
+    Render(RenderArgs),
     /// Compare two images with the perceptual metrics (not built yet).
     Diff(NotYet),
     /// Run a batch evaluation config (not built yet).
@@ -57,6 +60,114 @@ struct InfoArgs {
     json: bool,
     #[command(flatten)]
     load: LoadArgs,
+}
+
+#[derive(Args, Debug)]
+struct RenderArgs {
+    /// The mesh file.
+    mesh: PathBuf,
+    /// Output PNG (one view, or the contact sheet with --sheet).
+    #[arg(short, long, required_unless_present = "all_views")]
+    out: Option<PathBuf>,
+    /// Image width and height in pixels.
+    #[arg(long, default_value_t = 512)]
+    size: u32,
+    /// View rig: dodecahedron (20 views), icosahedron (12) or fibonacci:N.
+    #[arg(long, default_value = "dodecahedron")]
+    rig: String,
+    /// Which view of the rig to render.
+    #[arg(long, default_value_t = 0, conflicts_with_all = ["all_views", "sheet"])]
+    view: usize,
+    /// Render every view of the rig into --out-dir as view-NN.png.
+    #[arg(long, requires = "out_dir", conflicts_with = "sheet")]
+    all_views: bool,
+    /// Folder for --all-views.
+    #[arg(long)]
+    out_dir: Option<PathBuf>,
+    /// Write every view as one contact sheet (a grid) to --out.
+    #[arg(long)]
+    sheet: bool,
+    /// Shading model: unlit, gouraud, phong, normal-mapped, normals, depth.
+    #[arg(long, default_value = "gouraud")]
+    shading: String,
+    /// Samples per pixel (a square: 1, 4, 9, 16, ...).
+    #[arg(long, default_value_t = 4)]
+    samples: u32,
+    /// Sample grid: rotated or ordered.
+    #[arg(long, value_enum, default_value_t = PatternArg::Rotated)]
+    pattern: PatternArg,
+    /// Skip back-facing triangles (off by default, so flipped LOD triangles show).
+    #[arg(long)]
+    cull_backfaces: bool,
+    /// Also write linear float EXR beside each PNG.
+    #[arg(long)]
+    exr: bool,
+    #[command(flatten)]
+    load: LoadArgs,
+}
+
+#[derive(Copy, Clone, Debug, ValueEnum)]
+enum PatternArg {
+    /// Rotated ("n-rooks") grid.
+    Rotated,
+    /// Regular grid.
+    Ordered,
+}
+
+impl RenderArgs {
+    fn job(self) -> Result<RenderJob, Error> {
+        let rig = Rig::parse(&self.rig).ok_or_else(|| {
+            Error::Usage(format!(
+                "--rig {}: use dodecahedron, icosahedron or fibonacci:N",
+                self.rig
+            ))
+        })?;
+        let shading = Shading::parse(&self.shading).ok_or_else(|| {
+            let names: Vec<&str> = Shading::ALL.iter().map(|s| s.name()).collect();
+            Error::Usage(format!(
+                "--shading {}: use one of {}",
+                self.shading,
+                names.join(", ")
+            ))
+        })?;
+        let n = (self.samples as f64).sqrt().round() as u32;
+        if n * n != self.samples || n == 0 {
+            return Err(Error::Usage(format!(
+                "--samples {}: use a square number (1, 4, 9, 16, ...)",
+                self.samples
+            )));
+        }
+        let mut settings = RenderSettings::DEFAULT;
+        settings.width = self.size;
+        settings.height = self.size;
+        settings.shading = shading;
+        settings.cull_backfaces = self.cull_backfaces;
+        settings.samples = match self.pattern {
+            PatternArg::Rotated => SamplePattern::Rotated(n),
+            PatternArg::Ordered => SamplePattern::Ordered(n),
+        };
+        let views = match (self.all_views, self.sheet, self.out, self.out_dir) {
+            (true, _, _, Some(out_dir)) => ViewSelection::All { out_dir },
+            (_, true, Some(out), _) => ViewSelection::Sheet { out },
+            (_, _, Some(out), _) => ViewSelection::One {
+                view: self.view,
+                out,
+            },
+            _ => {
+                return Err(Error::Usage(
+                    "name an output with -o (or --all-views --out-dir DIR)".into(),
+                ));
+            }
+        };
+        Ok(RenderJob {
+            mesh: self.mesh,
+            load: self.load.options()?,
+            settings,
+            rig,
+            views,
+            exr: self.exr,
+        })
+    }
 }
 
 #[derive(Args, Debug)]
@@ -123,7 +234,6 @@ fn run(cli: Cli) -> Result<(), Error> {
             .build_global()
             .map_err(|e| Error::Internal(format!("cannot start {n} worker threads: {e}")))?;
     }
-    let _ = cli.quiet;
     match cli.command {
         Command::Info(a) => {
             let mesh = lodeval::mesh::load(&a.mesh, &a.load.options()?)?;
@@ -135,6 +245,17 @@ fn run(cli: Cli) -> Result<(), Error> {
             } else {
                 emit(&summary.to_string())
             }
+        }
+        Command::Render(a) => {
+            let written = lodeval::commands::render(&a.job()?)?;
+            if !cli.quiet {
+                eprintln!(
+                    "wrote {} file(s), first {}",
+                    written.len(),
+                    written[0].display()
+                );
+            }
+            Ok(())
         }
         other => {
             let name = format!("{other:?}")

@@ -8,8 +8,7 @@
 //! each once.
 //!
 //! Decisions: the metallic–roughness material is reduced to Blinn–Phong for lodeval's shading
-//! models: specular colour = mix(0.04, base colour, metallic), exponent = 2/α² − 2 with
-//! α = roughness² (the usual Beckmann–Phong correspondence; Walter et al. 2007, eq. 30).
+//! models by [`Material::specular_from_metallic_roughness`].
 //! Only `TEXCOORD_0` is read; a material that samples another set gets a warning.
 
 use std::collections::BTreeMap;
@@ -120,14 +119,18 @@ pub(crate) fn load(path: &Path, options: &LoadOptions) -> Result<MeshData> {
         let pbr = m.pbr_metallic_roughness();
         let [r, g, b, _] = pbr.base_color_factor();
         let base_color = Vec3::new(r, g, b);
-        let alpha = pbr.roughness_factor().clamp(0.03, 1.0).powi(2);
+        let (specular, shininess) = Material::specular_from_metallic_roughness(
+            base_color,
+            pbr.metallic_factor(),
+            pbr.roughness_factor(),
+        );
         let mut mat = Material {
             name: name.clone(),
             base_color,
             base_color_texture: None,
             normal_texture: None,
-            specular: Vec3::splat(0.04).lerp(base_color, pbr.metallic_factor()),
-            shininess: (2.0 / (alpha * alpha) - 2.0).clamp(1.0, 10_000.0),
+            specular,
+            shininess,
         };
         let wanted = [
             pbr.base_color_texture()
@@ -374,7 +377,11 @@ fn add_mesh(
         }
         match reader.read_tex_coords(0) {
             Some(t) => {
-                let t: Vec<Option<Vec2>> = t.into_f32().map(|t| Some(Vec2::from(t))).collect();
+                // glTF puts v = 0 at the top of the image; lodeval uses the OpenGL convention (bottom).
+                let t: Vec<Option<Vec2>> = t
+                    .into_f32()
+                    .map(|t| Some(Vec2::new(t[0], 1.0 - t[1])))
+                    .collect();
                 attr_len(t.len(), "TEXCOORD_0")?;
                 b.uvs.extend(t);
             }

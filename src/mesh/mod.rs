@@ -136,6 +136,19 @@ pub struct Material {
 }
 
 impl Material {
+    /// Blinn–Phong parameters for a metallic–roughness material (glTF, nvdiffrec MTL):
+    /// specular colour = mix(0.04, base colour, metallic), exponent = 2/α² − 2 with α = roughness²
+    /// (the Beckmann–Phong correspondence; Walter et al. 2007, eq. 30), clamped to 1..10 000.
+    pub fn specular_from_metallic_roughness(
+        base_color: Vec3,
+        metallic: f32,
+        roughness: f32,
+    ) -> (Vec3, f32) {
+        let alpha = roughness.clamp(0.03, 1.0).powi(2);
+        let specular = Vec3::splat(0.04).lerp(base_color, metallic.clamp(0.0, 1.0));
+        (specular, (2.0 / (alpha * alpha) - 2.0).clamp(1.0, 10_000.0))
+    }
+
     /// The material given to triangles the file assigns none: light grey diffuse with a faint
     /// highlight, so shape reads clearly under the default headlight.
     pub fn default_material() -> Material {

@@ -9,7 +9,9 @@
 //!
 //! Decisions: `l` and `p` records (lines, points) are ignored; polygons are fan-triangulated by
 //! `tobj`; OBJ vertex colours are taken as sRGB-encoded values in 0..1 and linearised; `map_Bump`,
-//! `bump` and `norm` all name a tangent-space normal map.
+//! `bump` and `norm` all name a tangent-space normal map; an MTL material with nvdiffrec's
+//! `bsdf pbr` line stores (occlusion, roughness, metallic) in `Ks`, not a specular colour (Spot
+//! and Bob from nvdiffrec would otherwise get a green highlight).
 
 use std::collections::HashMap;
 use std::io::Cursor;
@@ -379,10 +381,20 @@ pub(crate) fn load(path: &Path, options: &LoadOptions) -> Result<MeshData> {
         if let Some(kd) = m.diffuse {
             mat.base_color = Vec3::from(kd);
         }
-        if let Some(ks) = m.specular {
-            mat.specular = Vec3::from(ks);
+        let nvdiffrec_pbr = m
+            .unknown_param
+            .get("bsdf")
+            .is_some_and(|b| b.trim() == "pbr");
+        match (m.specular, nvdiffrec_pbr) {
+            // nvdiffrec's `bsdf pbr` MTL files store (occlusion, roughness, metallic) in Ks.
+            (Some([_, roughness, metallic]), true) => {
+                (mat.specular, mat.shininess) =
+                    Material::specular_from_metallic_roughness(mat.base_color, metallic, roughness);
+            }
+            (Some(ks), false) => mat.specular = Vec3::from(ks),
+            (None, _) => {}
         }
-        if let Some(ns) = m.shininess {
+        if let (Some(ns), false) = (m.shininess, nvdiffrec_pbr) {
             mat.shininess = ns.max(1.0);
         }
         let normal_name = m

@@ -1,0 +1,103 @@
+//! `Frame`: what a render produces — linear RGB colour, depth, coverage and triangle id per pixel —
+//! and its conversions to 8-bit sRGB images.
+
+use glam::Vec3;
+
+use crate::metric::color::linear_to_srgb;
+
+/// Triangle id of a pixel no triangle covers.
+pub const NO_TRIANGLE: u32 = u32::MAX;
+
+/// A rendered image with its diagnostic channels.
+///
+/// # Guarantees
+/// - `width, height >= 1`; every channel has `width * height` entries, row-major, top row first.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Frame {
+    pub(crate) width: u32,
+    pub(crate) height: u32,
+    /// Linear RGB, resolved over the samples.
+    pub(crate) color: Vec<Vec3>,
+    /// Nearest NDC depth (0 near .. 1 far) over the pixel's samples; `f32::INFINITY` if none.
+    pub(crate) depth: Vec<f32>,
+    /// Fraction of the pixel's samples covered by any triangle, 0..1.
+    pub(crate) coverage: Vec<f32>,
+    /// Source triangle covering most samples (ties: earliest sample), or [`NO_TRIANGLE`].
+    pub(crate) triangle: Vec<u32>,
+}
+
+impl Frame {
+    /// Width in pixels.
+    pub fn width(&self) -> u32 {
+        self.width
+    }
+    /// Height in pixels.
+    pub fn height(&self) -> u32 {
+        self.height
+    }
+    /// Linear RGB per pixel.
+    pub fn color(&self) -> &[Vec3] {
+        &self.color
+    }
+    /// Nearest NDC depth per pixel (`f32::INFINITY` where empty).
+    pub fn depth(&self) -> &[f32] {
+        &self.depth
+    }
+    /// Covered fraction of samples per pixel.
+    pub fn coverage(&self) -> &[f32] {
+        &self.coverage
+    }
+    /// Source triangle id per pixel ([`NO_TRIANGLE`] where empty).
+    pub fn triangle_ids(&self) -> &[u32] {
+        &self.triangle
+    }
+
+    /// The colour as 8-bit sRGB, RGB order (values outside 0..1 are clipped).
+    pub fn to_srgb8(&self) -> image::RgbImage {
+        let bytes = self
+            .color
+            .iter()
+            .flat_map(|c| {
+                c.to_array()
+                    .map(|v| (linear_to_srgb(v.clamp(0.0, 1.0)) * 255.0).round() as u8)
+            })
+            .collect();
+        image::RgbImage::from_raw(self.width, self.height, bytes)
+            .expect("sizes match by construction")
+    }
+
+    /// The colour as linear 32-bit float RGB (for EXR output).
+    pub fn to_rgb32f(&self) -> image::Rgb32FImage {
+        let v = self.color.iter().flat_map(|c| c.to_array()).collect();
+        image::Rgb32FImage::from_raw(self.width, self.height, v)
+            .expect("sizes match by construction")
+    }
+}
+
+/// Tile 8-bit images into a grid `columns` wide, in order, with a `gap`-pixel border of `bg`.
+/// All images must have the same size.
+pub fn contact_sheet(
+    images: &[image::RgbImage],
+    columns: u32,
+    gap: u32,
+    bg: [u8; 3],
+) -> image::RgbImage {
+    let columns = columns.max(1);
+    let (w, h) = images.first().map_or((1, 1), |i| i.dimensions());
+    let rows = (images.len() as u32).div_ceil(columns).max(1);
+    let mut sheet = image::RgbImage::from_pixel(
+        columns * (w + gap) + gap,
+        rows * (h + gap) + gap,
+        image::Rgb(bg),
+    );
+    for (k, img) in images.iter().enumerate() {
+        let (c, r) = (k as u32 % columns, k as u32 / columns);
+        image::imageops::replace(
+            &mut sheet,
+            img,
+            (gap + c * (w + gap)) as i64,
+            (gap + r * (h + gap)) as i64,
+        );
+    }
+    sheet
+}

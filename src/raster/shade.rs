@@ -1,0 +1,167 @@
+//! Shading models evaluated at a sample of a set-up triangle.
+//!
+//! Based on: James Blinn. Models of Light Reflection for Computer Synthesized Pictures.
+//! SIGGRAPH 1977 (the half-vector highlight); the OpenGL 1.x fixed-function lighting equation for an
+//! infinite light and infinite viewer (`GL_LIGHT_MODEL_LOCAL_VIEWER = false`), which Williams et al.
+//! 2003 use for vertex-lit models; Williams et al. 2003 §5.4, the luminance model
+//! Y = k_a·T + k_d·T·(N·L) + (N·H)^n, where texture modulates ambient and diffuse but not the
+//! highlight (separate specular colour).
+//!
+//! Colour = T ∘ K_d ∘ C_vertex ∘ (k_a + Σ_l c_l·max(N·L_l, 0)) + K_s ∘ Σ_l c_l·max(N·H_l, 0)^n
+//! (highlight only where N·L_l > 0). `gouraud` evaluates the bracketed light terms at vertices and
+//! interpolates them; `phong` and `normal-mapped` evaluate them per sample with the interpolated
+//! (and, for normal maps, perturbed) normal. Normals are not flipped for back faces: a flipped LOD
+//! triangle turns dark, which is how it should show up.
+//!
+//! Interpolation is perspective-correct: screen-space barycentrics λ_i are weighted by 1/w_i and
+//! renormalised, then mapped through the set-up triangle's corner barycentrics to the source
+//! triangle. Texture derivatives come from the same mapping evaluated one pixel to the right and
+//! one pixel down (analytic finite differences; no 2×2 quad needed).
+
+use glam::{Vec2, Vec3};
+
+use super::setup::SetupTri;
+use super::{PreparedMesh, Shading};
+use crate::mesh::Mesh;
+
+/// Everything shading needs for one frame.
+#[derive(Debug)]
+pub(crate) struct ShadeContext<'a> {
+    pub mesh: &'a Mesh,
+    pub prepared: &'a PreparedMesh,
+    pub setup: &'a [SetupTri],
+    pub shading: Shading,
+    /// (unit direction towards the light, colour), world space.
+    pub lights: Vec<(Vec3, Vec3)>,
+    /// Unit direction towards the (infinite) viewer.
+    pub to_eye: Vec3,
+    pub ambient: f32,
+    /// Per-vertex (diffuse light, specular) terms for `gouraud`.
+    pub vertex_light: Vec<(Vec3, Vec3)>,
+    /// Near and far distances and whether the projection is perspective (for the depth view).
+    pub depth_range: (f32, f32, bool),
+}
+
+/// Light terms at a normal: (k_a + Σ c·max(N·L,0), K_s ∘ Σ c·max(N·H,0)^n).
+pub(crate) fn light_terms(
+    n: Vec3,
+    lights: &[(Vec3, Vec3)],
+    to_eye: Vec3,
+    ambient: f32,
+    ks: Vec3,
+    shininess: f32,
+) -> (Vec3, Vec3) {
+    let mut diffuse = Vec3::splat(ambient);
+    let mut spec = Vec3::ZERO;
+    for &(l, c) in lights {
+        let ndl = n.dot(l);
+        if ndl > 0.0 {
+            diffuse += c * ndl;
+            let h = (l + to_eye).normalize_or_zero();
+            spec += c * n.dot(h).max(0.0).powf(shininess);
+        }
+    }
+    (diffuse, ks * spec)
+}
+
+impl ShadeContext<'_> {
+    /// Source-triangle barycentrics at screen point (x, y) in pixels, and the screen-space ones.
+    fn barycentrics(&self, st: &SetupTri, x: f64, y: f64) -> (Vec3, [f64; 3]) {
+        let p = st.v.map(|q| [q[0] as f64 / 256.0, q[1] as f64 / 256.0]);
+        let area = st.area as f64 / 65536.0;
+        let mut lambda = [0f64; 3];
+        for (i, l) in lambda.iter_mut().enumerate() {
+            let (a, b) = (p[(i + 1) % 3], p[(i + 2) % 3]);
+            *l = ((b[0] - a[0]) * (y - a[1]) - (b[1] - a[1]) * (x - a[0])) / area;
+        }
+        let mu: Vec<f64> = (0..3).map(|i| lambda[i] * st.inv_w[i] as f64).collect();
+        let sum = mu[0] + mu[1] + mu[2];
+        let mu = if sum != 0.0 {
+            [mu[0] / sum, mu[1] / sum, mu[2] / sum]
+        } else {
+            [1.0 / 3.0; 3]
+        };
+        let b = st.bary[0] * mu[0] as f32 + st.bary[1] * mu[1] as f32 + st.bary[2] * mu[2] as f32;
+        (b, lambda)
+    }
+
+    /// Shade set-up triangle `id` at screen point (x, y) (pixels).
+    pub fn shade(&self, id: u32, x: f64, y: f64) -> Vec3 {
+        let st = &self.setup[id as usize];
+        let tri = self.mesh.triangles()[st.tri as usize].map(|i| i as usize);
+        let (b, lambda) = self.barycentrics(st, x, y);
+        let lerp3 = |a: &[Vec3]| a[tri[0]] * b.x + a[tri[1]] * b.y + a[tri[2]] * b.z;
+        let material_id = self.mesh.material_ids()[st.tri as usize] as usize;
+        let material = &self.mesh.materials()[material_id];
+        let textures = &self.prepared.materials[material_id];
+
+        match self.shading {
+            Shading::Normals => return lerp3(self.mesh.normals()).normalize_or_zero() * 0.5 + 0.5,
+            Shading::Depth => {
+                let (near, far, perspective) = self.depth_range;
+                let t = if perspective {
+                    let inv_w: f64 = (0..3).map(|i| lambda[i] * st.inv_w[i] as f64).sum();
+                    ((1.0 / inv_w) as f32 - near) / (far - near)
+                } else {
+                    (0..3).map(|i| lambda[i] as f32 * st.z[i]).sum()
+                };
+                return Vec3::splat(1.0 - t.clamp(0.0, 1.0));
+            }
+            _ => {}
+        }
+
+        // Surface colour: base colour × vertex colour × texture.
+        let uv_at =
+            |bb: Vec3, uvs: &[Vec2]| uvs[tri[0]] * bb.x + uvs[tri[1]] * bb.y + uvs[tri[2]] * bb.z;
+        let uv_frame = self.mesh.uvs().map(|uvs| {
+            let uv = uv_at(b, uvs);
+            let dx = uv_at(self.barycentrics(st, x + 1.0, y).0, uvs) - uv;
+            let dy = uv_at(self.barycentrics(st, x, y + 1.0).0, uvs) - uv;
+            (uv, dx, dy)
+        });
+        let mut albedo = material.base_color;
+        if let Some(colors) = self.mesh.colors() {
+            albedo *= lerp3(colors);
+        }
+        if let (Some(tex), Some((uv, dx, dy))) = (&textures.base, uv_frame) {
+            albedo *= tex.sample(uv, dx, dy);
+        }
+        if self.shading == Shading::Unlit {
+            return albedo;
+        }
+
+        let (diffuse, spec) = match self.shading {
+            Shading::Gouraud => {
+                let vl = &self.vertex_light;
+                let d = vl[tri[0]].0 * b.x + vl[tri[1]].0 * b.y + vl[tri[2]].0 * b.z;
+                let s = vl[tri[0]].1 * b.x + vl[tri[1]].1 * b.y + vl[tri[2]].1 * b.z;
+                (d, s)
+            }
+            _ => {
+                let mut n = lerp3(self.mesh.normals()).normalize_or_zero();
+                if self.shading == Shading::NormalMapped {
+                    if let (Some(map), Some(tangents), Some((uv, dx, dy))) =
+                        (&textures.normal, &self.prepared.tangents, uv_frame)
+                    {
+                        let t4 = tangents[tri[0]] * b.x
+                            + tangents[tri[1]] * b.y
+                            + tangents[tri[2]] * b.z;
+                        let t = (t4.truncate() - n * n.dot(t4.truncate())).normalize_or_zero();
+                        let bitangent = n.cross(t) * if t4.w < 0.0 { -1.0 } else { 1.0 };
+                        let m = map.sample(uv, dx, dy) * 2.0 - 1.0;
+                        n = (t * m.x + bitangent * m.y + n * m.z).normalize_or(n);
+                    }
+                }
+                light_terms(
+                    n,
+                    &self.lights,
+                    self.to_eye,
+                    self.ambient,
+                    material.specular,
+                    material.shininess,
+                )
+            }
+        };
+        albedo * diffuse + spec
+    }
+}

@@ -1,0 +1,59 @@
+//! What is rendered and from where: cameras framed on the model, view rigs, lights, viewing
+//! conditions. `raster/` (and later `gpu/`) consume these types; nothing here rasterizes.
+
+mod camera;
+mod light;
+mod rig;
+
+pub use camera::{Camera, Projection};
+pub use light::{HEADLIGHT_OFFSET, Light};
+pub use rig::Rig;
+
+use std::sync::Arc;
+
+use glam::Vec3;
+
+use crate::mesh::Mesh;
+use crate::metric::color::srgb_to_linear;
+use crate::raster::PreparedMesh;
+
+/// A mesh ready to render, with its lights and background.
+///
+/// Building a scene does the per-mesh work once (mip pyramids, tangents); every view of it
+/// reuses that work.
+#[derive(Debug, Clone)]
+pub struct Scene {
+    mesh: Arc<Mesh>,
+    prepared: Arc<PreparedMesh>,
+    /// Lights. Default value: one [`Light::HEADLIGHT`].
+    pub lights: Vec<Light>,
+    /// Linear RGB background. Default value: mid-grey, sRGB 0.5 (≈ 0.214 linear).
+    pub background: Vec3,
+    /// Ambient term k_a of the Blinn–Phong models. Default value: 0.15.
+    pub ambient: f32,
+}
+
+impl Scene {
+    /// Default ambient term.
+    pub const DEFAULT_AMBIENT: f32 = 0.15;
+
+    /// A scene with DESIGN.md's defaults: one headlight, mid-grey background.
+    pub fn new(mesh: Arc<Mesh>) -> Scene {
+        let prepared = Arc::new(PreparedMesh::new(&mesh));
+        Scene {
+            mesh,
+            prepared,
+            lights: vec![Light::HEADLIGHT],
+            background: Vec3::splat(srgb_to_linear(0.5)),
+            ambient: Self::DEFAULT_AMBIENT,
+        }
+    }
+    /// The mesh.
+    pub fn mesh(&self) -> &Mesh {
+        &self.mesh
+    }
+    /// Per-mesh render data.
+    pub fn prepared(&self) -> &PreparedMesh {
+        &self.prepared
+    }
+}
