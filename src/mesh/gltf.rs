@@ -8,7 +8,8 @@
 //! each once.
 //!
 //! Decisions: the metallic–roughness material is reduced to Blinn–Phong for lodeval's shading
-//! models by [`Material::specular_from_metallic_roughness`].
+//! models by [`Material::specular_from_metallic_roughness`], with the mean of the
+//! metallic-roughness texture standing in for the texture (one specular colour per material).
 //! Only `TEXCOORD_0` is read; a material that samples another set gets a warning.
 
 use std::collections::BTreeMap;
@@ -74,6 +75,18 @@ fn rgba8_from(data: gltf::image::Data) -> std::result::Result<(u32, u32, Vec<u8>
     Ok((data.width, data.height, rgba))
 }
 
+/// Mean of the R, G and B channels of RGBA8 texels, in 0..1.
+fn mean_channels(rgba: &[u8]) -> [f32; 3] {
+    let mut sum = [0u64; 3];
+    for px in rgba.chunks_exact(4) {
+        for c in 0..3 {
+            sum[c] += px[c] as u64;
+        }
+    }
+    let n = (rgba.len() / 4).max(1) as f64 * 255.0;
+    sum.map(|s| (s as f64 / n) as f32)
+}
+
 /// Load a glTF or GLB file.
 pub(crate) fn load(path: &Path, options: &LoadOptions) -> Result<MeshData> {
     let bytes = read_file(path)?;
@@ -119,11 +132,30 @@ pub(crate) fn load(path: &Path, options: &LoadOptions) -> Result<MeshData> {
         let pbr = m.pbr_metallic_roughness();
         let [r, g, b, _] = pbr.base_color_factor();
         let base_color = Vec3::new(r, g, b);
-        let (specular, shininess) = Material::specular_from_metallic_roughness(
-            base_color,
-            pbr.metallic_factor(),
-            pbr.roughness_factor(),
-        );
+        // The metallic-roughness texture (G = roughness, B = metallic) scales the factors; lodeval's
+        // Blinn–Phong material has one specular colour and exponent, so the texture's mean is used.
+        let (mut metallic, mut roughness) = (pbr.metallic_factor(), pbr.roughness_factor());
+        if let Some(info) = pbr.metallic_roughness_texture() {
+            let mean = gltf::image::Data::from_source(
+                info.texture().source().source(),
+                Some(base),
+                &buffers,
+            )
+            .ok()
+            .and_then(|d| rgba8_from(d).ok())
+            .map(|(_, _, px)| mean_channels(&px));
+            match mean {
+                Some([_, g, b]) => {
+                    roughness *= g;
+                    metallic *= b;
+                }
+                None => warnings.push(format!(
+                    "material '{name}': metallic-roughness texture unreadable; using the factors"
+                )),
+            }
+        }
+        let (specular, shininess) =
+            Material::specular_from_metallic_roughness(base_color, metallic, roughness);
         let mut mat = Material {
             name: name.clone(),
             base_color,

@@ -27,6 +27,7 @@ mod normals;
 mod obj;
 mod off;
 mod ply;
+pub mod shapes;
 mod summary;
 mod texture;
 mod validate;

@@ -5,10 +5,13 @@
 //!   the file and the problem, and never panic.
 //! - `models`: `lodeval info` on every model of the shared collection against MANIFEST.md's counts
 //!   (skipped only when `../shared` is absent) and on the shipped `reference/models`.
-//! - `fuzz`: property-based mutation fuzzing of the OBJ, PLY and OFF paths.
+//! - `fuzz`: property-based mutation fuzzing of the OBJ, PLY, OFF and GLB paths.
+//! - `raster`: the CPU rasterizer (determinism over thread counts, watertightness, golden images,
+//!   the `render` CLI).
 
 mod bad_input;
 mod cli;
 mod common;
 mod fuzz;
 mod models;
+mod raster;
