@@ -55,7 +55,7 @@ fn zero_threads_is_a_usage_error() {
 #[test]
 fn unbuilt_subcommands_say_so_and_exit_2() {
     for cmd in [
-        "render", "diff", "eval", "golden", "simplify", "optimize", "bench", "merge",
+        "diff", "eval", "golden", "simplify", "optimize", "bench", "merge",
     ] {
         let r = lodeval([cmd, "whatever", "--flag"]);
         assert_eq!(r.code, 2, "{cmd}: {}", r.stderr);
