@@ -122,3 +122,84 @@ pub fn render(job: &RenderJob) -> Result<Vec<PathBuf>> {
     }
     Ok(written)
 }
+
+/// A `lodeval bench raster` request.
+#[derive(Debug, Clone)]
+pub struct RasterBench {
+    /// Torus resolution: `rings × sides × 2` triangles (1000 × 500 gives exactly 1 M).
+    pub rings: u32,
+    /// See `rings`.
+    pub sides: u32,
+    /// Image edge in pixels.
+    pub size: u32,
+    /// Views (Fibonacci rig), rendered once each per sample setting.
+    pub views: u32,
+    /// Sample counts to measure (each a square).
+    pub samples: Vec<u32>,
+    /// Shading model.
+    pub shading: raster::Shading,
+}
+
+/// One line of the benchmark table.
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct RasterBenchRow {
+    /// Triangles in the mesh.
+    pub triangles: usize,
+    /// Image edge, pixels.
+    pub size: u32,
+    /// Samples per pixel.
+    pub samples: u32,
+    /// Views rendered.
+    pub views: u32,
+    /// Worker threads.
+    pub threads: usize,
+    /// Mean milliseconds per frame.
+    pub ms_per_frame: f64,
+    /// Frames per second.
+    pub frames_per_s: f64,
+    /// Millions of triangles per second.
+    pub mtri_per_s: f64,
+}
+
+/// Render a procedural torus from every view and time it. Timing is for reporting only: nothing
+/// asserts on it.
+pub fn bench_raster(b: &RasterBench) -> Result<Vec<RasterBenchRow>> {
+    let mesh = Arc::new(crate::mesh::shapes::torus(b.rings, b.sides, 0.35));
+    let scene = Scene::new(mesh.clone());
+    let cameras = rig_cameras(&mesh, &Rig::Fibonacci(b.views), 1.0);
+    let mut rows = Vec::new();
+    for &samples in &b.samples {
+        let n = (samples as f64).sqrt().round() as u32;
+        let mut settings = RenderSettings::DEFAULT;
+        settings.width = b.size;
+        settings.height = b.size;
+        settings.shading = b.shading;
+        settings.samples = raster::SamplePattern::Rotated(n);
+        // Warm-up frame (page faults, allocator), not timed.
+        raster::render(&scene, &cameras[0], &settings)?;
+        let start = std::time::Instant::now();
+        for c in &cameras {
+            std::hint::black_box(raster::render(&scene, c, &settings)?);
+        }
+        let secs = start.elapsed().as_secs_f64() / cameras.len() as f64;
+        rows.push(RasterBenchRow {
+            triangles: mesh.triangle_count(),
+            size: b.size,
+            samples: n * n,
+            views: b.views,
+            threads: rayon::current_num_threads(),
+            ms_per_frame: secs * 1e3,
+            frames_per_s: 1.0 / secs,
+            mtri_per_s: mesh.triangle_count() as f64 / secs / 1e6,
+        });
+    }
+    Ok(rows)
+}
+
+/// Peak resident set size of this process in MiB (Linux `VmHWM`), if known.
+pub fn peak_rss_mib() -> Option<f64> {
+    let status = std::fs::read_to_string("/proc/self/status").ok()?;
+    let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
+    let kib: f64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kib / 1024.0)
+}

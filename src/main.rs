@@ -45,8 +45,8 @@ enum Command {
     Simplify(NotYet),
     /// Image-driven optimisation of a simplified mesh (not built yet).
     Optimize(NotYet),
-    /// Run the benchmarks (not built yet).
-    Bench(NotYet),
+    /// Run a benchmark (`raster`) and print its table.
+    Bench(BenchArgs),
     /// Merge the outputs of sharded runs (not built yet).
     Merge(NotYet),
 }
@@ -104,6 +104,33 @@ struct RenderArgs {
     exr: bool,
     #[command(flatten)]
     load: LoadArgs,
+}
+
+#[derive(Args, Debug)]
+struct BenchArgs {
+    /// What to measure: `raster`.
+    what: String,
+    /// Torus rings (triangles = 2 · rings · sides).
+    #[arg(long, default_value_t = 1000)]
+    rings: u32,
+    /// Torus sides.
+    #[arg(long, default_value_t = 500)]
+    sides: u32,
+    /// Image edge in pixels.
+    #[arg(long, default_value_t = 1024)]
+    size: u32,
+    /// Number of views (Fibonacci rig).
+    #[arg(long, default_value_t = 20)]
+    views: u32,
+    /// Samples per pixel to measure, comma separated.
+    #[arg(long, value_delimiter = ',', default_value = "1,4")]
+    samples: Vec<u32>,
+    /// Shading model.
+    #[arg(long, default_value = "gouraud")]
+    shading: String,
+    /// Print JSON rows instead of a table.
+    #[arg(long)]
+    json: bool,
 }
 
 #[derive(Copy, Clone, Debug, ValueEnum)]
@@ -256,6 +283,59 @@ fn run(cli: Cli) -> Result<(), Error> {
                 );
             }
             Ok(())
+        }
+        Command::Bench(a) => {
+            if a.what != "raster" {
+                return Err(Error::Usage(format!(
+                    "lodeval bench {}: the benchmark built so far is `raster`",
+                    a.what
+                )));
+            }
+            let shading = Shading::parse(&a.shading).ok_or_else(|| {
+                Error::Usage(format!("--shading {}: unknown shading model", a.shading))
+            })?;
+            if let Some(bad) = a
+                .samples
+                .iter()
+                .find(|&&s| ((s as f64).sqrt().round() as u32).pow(2) != s || s == 0)
+            {
+                return Err(Error::Usage(format!(
+                    "--samples {bad}: use square numbers (1, 4, 9, ...)"
+                )));
+            }
+            let job = lodeval::commands::RasterBench {
+                rings: a.rings,
+                sides: a.sides,
+                size: a.size,
+                views: a.views,
+                samples: a.samples,
+                shading,
+            };
+            let rows = lodeval::commands::bench_raster(&job)?;
+            let rss = lodeval::commands::peak_rss_mib().unwrap_or(f64::NAN);
+            let mut text = String::new();
+            if a.json {
+                text = serde_json::to_string_pretty(&rows)
+                    .map_err(|e| Error::Internal(e.to_string()))?
+                    + "\n";
+            } else {
+                text.push_str("| triangles | size | samples | views | threads | ms/frame | frames/s | Mtri/s |\n|---|---|---|---|---|---|---|---|\n");
+                for r in &rows {
+                    text.push_str(&format!(
+                        "| {} | {} | {} | {} | {} | {:.1} | {:.2} | {:.1} |\n",
+                        r.triangles,
+                        r.size,
+                        r.samples,
+                        r.views,
+                        r.threads,
+                        r.ms_per_frame,
+                        r.frames_per_s,
+                        r.mtri_per_s
+                    ));
+                }
+                text.push_str(&format!("peak RSS: {rss:.0} MiB\n"));
+            }
+            emit(&text)
         }
         other => {
             let name = format!("{other:?}")

@@ -1,27 +1,55 @@
-//! Tile binning: which set-up triangles touch which screen tile.
+//! Triangle set-up fused with tile binning, per chunk of source triangles.
 //!
-//! The screen is cut into [`TILE`]×[`TILE`] pixel tiles; each tile gets the list of set-up triangle
-//! indices whose bounding box overlaps it, in increasing index order (binning runs over fixed
-//! chunks in parallel and concatenates per tile in chunk order). Tiles are then rasterized
-//! independently, each owning its pixels, so no two threads ever write the same sample and the
-//! result does not depend on scheduling. The region re-render uses the same bins to find the
-//! triangles overlapping a rectangle without scanning every triangle.
+//! The source triangles are cut into fixed chunks of [`CHUNK`]; each chunk (one parallel task) sets
+//! up its triangles (`setup.rs`) and counting-sorts them by the [`TILE`]×[`TILE`] screen tiles their
+//! bounding boxes touch, keeping triangle order within each tile. A tile's triangle list is the
+//! concatenation of its slice in every chunk, in chunk order — so it is in source-triangle order,
+//! whatever the thread count, without ever copying the set-up triangles into one array.
+//! Set-up triangle ids are `chunk << 16 | index within chunk` (a chunk of 4096 source triangles
+//! yields at most 7 × 4096 < 2^16 clipped triangles).
+//!
+//! Tiles are then rasterized independently, each owning its pixels, so no two threads write the
+//! same sample. The region re-render uses the same lists to find the triangles overlapping a
+//! rectangle without scanning every triangle.
 
 use rayon::prelude::*;
 
-use super::setup::SetupTri;
+use super::clip::ClipPlanes;
+use super::setup::{SetupTri, Viewport, XfVertex, setup_one};
 
 /// Tile edge in pixels.
 pub const TILE: u32 = 64;
+/// Source triangles per set-up chunk.
+const CHUNK: usize = 4096;
 
-/// Per-tile triangle lists.
+/// The set-up triangles of one chunk, sorted by tile.
 #[derive(Debug, Clone)]
-pub(crate) struct Bins {
-    pub tiles_x: u32,
-    pub lists: Vec<Vec<u32>>,
+pub(crate) struct SetupChunk {
+    tris: Vec<SetupTri>,
+    /// `items[tile_start[t]..tile_start[t + 1]]` are the triangles (indices into `tris`) of tile t.
+    tile_start: Vec<u32>,
+    items: Vec<u16>,
 }
 
-impl Bins {
+/// All set-up triangles of a frame, binned.
+#[derive(Debug, Clone)]
+pub(crate) struct Binned {
+    chunks: Vec<SetupChunk>,
+    tiles_x: u32,
+    n_tiles: usize,
+}
+
+impl Binned {
+    /// The set-up triangle with id `id`.
+    pub fn get(&self, id: u32) -> &SetupTri {
+        &self.chunks[(id >> 16) as usize].tris[(id & 0xFFFF) as usize]
+    }
+
+    /// Number of tiles.
+    pub fn tile_count(&self) -> usize {
+        self.n_tiles
+    }
+
     /// Pixel rectangle `[x0, y0, x1, y1)` of tile `t`.
     pub fn tile_rect(&self, t: usize, width: u32, height: u32) -> [i32; 4] {
         let (tx, ty) = (t as u32 % self.tiles_x, t as u32 / self.tiles_x);
@@ -32,42 +60,70 @@ impl Bins {
             ((ty + 1) * TILE).min(height) as i32,
         ]
     }
+
+    /// The set-up triangles touching tile `t`, as (id, triangle), in source-triangle order.
+    pub fn tile(&self, t: usize) -> impl Iterator<Item = (u32, &SetupTri)> {
+        self.chunks.iter().enumerate().flat_map(move |(c, chunk)| {
+            let range = chunk.tile_start[t] as usize..chunk.tile_start[t + 1] as usize;
+            chunk.items[range]
+                .iter()
+                .map(move |&k| (((c as u32) << 16) | k as u32, &chunk.tris[k as usize]))
+        })
+    }
 }
 
-/// Bin set-up triangles into tiles.
-pub(crate) fn bin(tris: &[SetupTri], width: u32, height: u32) -> Bins {
-    let tiles_x = width.div_ceil(TILE);
-    let tiles_y = height.div_ceil(TILE);
-    let n_tiles = (tiles_x * tiles_y) as usize;
-    const CHUNK: usize = 16 * 1024;
-    let partial: Vec<Vec<Vec<u32>>> = tris
+/// Set up and bin every triangle.
+pub(crate) fn setup_and_bin(
+    triangles: &[[u32; 3]],
+    xf: &[XfVertex],
+    planes: &ClipPlanes,
+    vp: Viewport,
+) -> Binned {
+    let tiles_x = vp.width.div_ceil(TILE);
+    let n_tiles = (tiles_x * vp.height.div_ceil(TILE)) as usize;
+    let chunks = triangles
         .par_chunks(CHUNK)
         .enumerate()
         .map(|(c, chunk)| {
-            let mut lists = vec![Vec::new(); n_tiles];
+            let mut tris = Vec::with_capacity(chunk.len());
             for (k, t) in chunk.iter().enumerate() {
+                setup_one((c * CHUNK + k) as u32, *t, xf, planes, vp, &mut tris);
+            }
+            // Counting sort by tile: count, prefix-sum, scatter (keeps triangle order per tile).
+            let tiles_of = |t: &SetupTri| {
                 let [x0, y0, x1, y1] = t.bbox;
                 let (tx0, ty0) = (x0 as u32 / TILE, y0 as u32 / TILE);
                 let (tx1, ty1) = ((x1 as u32 - 1) / TILE, (y1 as u32 - 1) / TILE);
-                for ty in ty0..=ty1 {
-                    for tx in tx0..=tx1 {
-                        lists[(ty * tiles_x + tx) as usize].push((c * CHUNK + k) as u32);
-                    }
+                (ty0..=ty1)
+                    .flat_map(move |ty| (tx0..=tx1).map(move |tx| (ty * tiles_x + tx) as usize))
+            };
+            let mut tile_start = vec![0u32; n_tiles + 1];
+            for t in &tris {
+                for tile in tiles_of(t) {
+                    tile_start[tile + 1] += 1;
                 }
             }
-            lists
-        })
-        .collect();
-    let lists = (0..n_tiles)
-        .into_par_iter()
-        .map(|t| {
-            let total = partial.iter().map(|p| p[t].len()).sum();
-            let mut list = Vec::with_capacity(total);
-            for p in &partial {
-                list.extend_from_slice(&p[t]);
+            for i in 0..n_tiles {
+                tile_start[i + 1] += tile_start[i];
             }
-            list
+            let mut fill = tile_start.clone();
+            let mut items = vec![0u16; tile_start[n_tiles] as usize];
+            for (k, t) in tris.iter().enumerate() {
+                for tile in tiles_of(t) {
+                    items[fill[tile] as usize] = k as u16;
+                    fill[tile] += 1;
+                }
+            }
+            SetupChunk {
+                tris,
+                tile_start,
+                items,
+            }
         })
         .collect();
-    Bins { tiles_x, lists }
+    Binned {
+        chunks,
+        tiles_x,
+        n_tiles,
+    }
 }

@@ -41,6 +41,12 @@ impl ClipPlanes {
         }
     }
 
+    /// The planes for a viewport of `width` × `height` pixels with the guard band of `fixed.rs`.
+    pub fn for_viewport(width: u32, height: u32) -> ClipPlanes {
+        let g = super::fixed::GUARD_BAND_PX;
+        ClipPlanes::new(1.0 + 2.0 * g / width as f32, 1.0 + 2.0 * g / height as f32)
+    }
+
     /// Bit mask of the planes a point is outside of.
     pub fn outcode(&self, p: Vec4) -> u8 {
         let mut code = 0;

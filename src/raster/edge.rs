@@ -48,12 +48,14 @@ impl TileSamples {
 
 /// Rasterize set-up triangle `st` (index `id`) into `buf`, restricted to `clip` (a sub-rectangle
 /// of the tile, `[x0, y0, x1, y1)`). `offsets` are the sample positions within a pixel in Fx24_8.
+/// `scratch` must hold at least `offsets.len()` entries.
 pub(crate) fn rasterize(
     st: &SetupTri,
     id: u32,
     offsets: &[[i64; 2]],
     clip: [i32; 4],
     buf: &mut TileSamples,
+    scratch: &mut [[i64; 3]],
 ) {
     let x0 = st.bbox[0].max(clip[0]);
     let y0 = st.bbox[1].max(clip[1]);
@@ -79,11 +81,12 @@ pub(crate) fn rasterize(
         bias[i] = if top_left { 0 } else { -1 };
     }
     let s = offsets.len();
-    // Per-sample offsets of each edge value from the pixel corner, bias folded in.
-    let mut sample_off = [[0i64; 3]; 64];
-    for (k, o) in offsets.iter().enumerate() {
+    // Per-sample offsets of each edge value from the pixel corner, bias folded in, written into the
+    // caller's scratch (a zero-initialised array per triangle cost more than the rasterization).
+    let sample_off = &mut scratch[..s];
+    for (so, o) in sample_off.iter_mut().zip(offsets) {
         for i in 0..3 {
-            sample_off[k][i] = coef[i][0] * o[0] + coef[i][1] * o[1] + bias[i];
+            so[i] = coef[i][0] * o[0] + coef[i][1] * o[1] + bias[i];
         }
     }
     let inv_area = 1.0 / st.area as f64;
@@ -95,7 +98,7 @@ pub(crate) fn rasterize(
         let base_y = (y - buf.rect[1]) as usize * tile_w;
         for x in x0..x1 {
             let base = (base_y + (x - buf.rect[0]) as usize) * s;
-            for (k, so) in sample_off[..s].iter().enumerate() {
+            for (k, so) in sample_off.iter().enumerate() {
                 let (e0, e1, e2) = (e[0] + so[0], e[1] + so[1], e[2] + so[2]);
                 if (e0 | e1 | e2) < 0 {
                     continue;

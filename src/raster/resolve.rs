@@ -4,10 +4,11 @@
 use glam::Vec3;
 use rayon::prelude::*;
 
-use super::bin::{self, Bins};
+use super::bin::{self, Binned};
+use super::clip::ClipPlanes;
 use super::edge::{self, EMPTY, TileSamples};
 use super::frame::{Frame, NO_TRIANGLE};
-use super::setup::{self, SetupTri, Viewport};
+use super::setup::{self, Viewport};
 use super::shade::ShadeContext;
 use super::{RenderSettings, camera_setup, vertex_lighting};
 use crate::scene::{Camera, Scene};
@@ -16,8 +17,7 @@ use crate::scene::{Camera, Scene};
 pub(crate) struct Pass<'a> {
     scene: &'a Scene,
     settings: RenderSettings,
-    setup: Vec<SetupTri>,
-    bins: Bins,
+    binned: Binned,
     offsets: Vec<[i64; 2]>,
     count_coverage: bool,
     ctx_parts: (Vec<(Vec3, Vec3)>, Vec3, (f32, f32, bool)),
@@ -42,21 +42,20 @@ impl<'a> Pass<'a> {
         let mesh = scene.mesh();
         let (mvp, depth_range) = camera_setup(camera, settings.width, settings.height);
         // Stage 1: transform and set up triangles.
-        let clip = setup::transform(mesh.positions(), mvp);
         let vp = Viewport {
             width: settings.width,
             height: settings.height,
             cull_backfaces: settings.cull_backfaces,
         };
-        let setup = setup::setup_all(mesh.triangles(), &clip, vp);
-        // Stage 2: bin into tiles.
-        let bins = bin::bin(&setup, settings.width, settings.height);
+        let planes = ClipPlanes::for_viewport(settings.width, settings.height);
+        let xf = setup::transform(mesh.positions(), mvp, &planes, vp);
+        // Stage 2 (fused with set-up, per chunk): bin into tiles.
+        let binned = bin::setup_and_bin(mesh.triangles(), &xf, &planes, vp);
         let lights = scene.lights.iter().map(|l| l.resolve(camera)).collect();
         Pass {
             scene,
             settings: *settings,
-            setup,
-            bins,
+            binned,
             offsets: settings.samples.offsets(),
             count_coverage,
             ctx_parts: (lights, camera.to_eye(), depth_range),
@@ -67,7 +66,7 @@ impl<'a> Pass<'a> {
         let mut ctx = ShadeContext {
             mesh: self.scene.mesh(),
             prepared: self.scene.prepared(),
-            setup: &self.setup,
+            setup: &self.binned,
             shading: self.settings.shading,
             lights: self.ctx_parts.0.clone(),
             to_eye: self.ctx_parts.1,
@@ -84,11 +83,12 @@ impl<'a> Pass<'a> {
     /// Stage 3: scan-convert every triangle of tile `t` (in index order).
     fn raster_tile(&self, t: usize) -> TileSamples {
         let rect = self
-            .bins
+            .binned
             .tile_rect(t, self.settings.width, self.settings.height);
         let mut buf = TileSamples::new(rect, self.offsets.len(), self.count_coverage);
-        for &id in &self.bins.lists[t] {
-            edge::rasterize(&self.setup[id as usize], id, &self.offsets, rect, &mut buf);
+        let mut scratch = vec![[0i64; 3]; self.offsets.len()];
+        for (id, tri) in self.binned.tile(t) {
+            edge::rasterize(tri, id, &self.offsets, rect, &mut buf, &mut scratch);
         }
         buf
     }
@@ -147,7 +147,7 @@ impl<'a> Pass<'a> {
                 out.depth.push(depth);
                 out.coverage.push((s - empty) as f32 / s as f32);
                 out.triangle
-                    .push(best.map_or(NO_TRIANGLE, |(id, _)| self.setup[id as usize].tri));
+                    .push(best.map_or(NO_TRIANGLE, |(id, _)| self.binned.get(id).tri));
             }
         }
         out
@@ -156,7 +156,7 @@ impl<'a> Pass<'a> {
     /// Rasterize and resolve every tile, then assemble the frame.
     pub fn resolve_frame(&self) -> Frame {
         let ctx = self.context();
-        let tiles: Vec<TileOut> = (0..self.bins.lists.len())
+        let tiles: Vec<TileOut> = (0..self.binned.tile_count())
             .into_par_iter()
             .map(|t| self.resolve_tile(&ctx, &self.raster_tile(t)))
             .collect();
@@ -187,7 +187,7 @@ impl<'a> Pass<'a> {
 
     /// Per-sample coverage counts over the whole image, row-major per pixel.
     pub fn counts(&self) -> Vec<u16> {
-        let tiles: Vec<TileSamples> = (0..self.bins.lists.len())
+        let tiles: Vec<TileSamples> = (0..self.binned.tile_count())
             .into_par_iter()
             .map(|t| self.raster_tile(t))
             .collect();

@@ -1,8 +1,7 @@
 //! Vertex transform and triangle setup: clip space → clipped → perspective divide → viewport →
 //! fixed-point screen triangles with a consistent orientation.
 //!
-//! Runs in parallel over fixed chunks of triangles; chunk outputs are concatenated in chunk order,
-//! so the list of set-up triangles (and everything downstream) is independent of thread count.
+//! `bin.rs` calls [`setup_one`] for fixed chunks of triangles in parallel.
 //!
 //! Conventions: screen x grows right, y grows down, pixel (x, y) covers [x, x+1) × [y, y+1) and its
 //! centre is (x + ½, y + ½). Front faces are counter-clockwise in NDC (OpenGL/glTF convention);
@@ -13,10 +12,7 @@ use glam::{Mat4, Vec3, Vec4};
 use rayon::prelude::*;
 
 use super::clip::{ClipPlanes, ClipVertex};
-use super::fixed::{Fx24_8, GUARD_BAND_PX};
-
-/// Triangles per parallel set-up chunk.
-const CHUNK: usize = 4096;
+use super::fixed::Fx24_8;
 
 /// A triangle ready for rasterization.
 ///
@@ -51,93 +47,116 @@ pub(crate) struct Viewport {
     pub cull_backfaces: bool,
 }
 
-/// Transform every position to clip space.
-pub(crate) fn transform(positions: &[Vec3], mvp: Mat4) -> Vec<Vec4> {
-    positions
-        .par_iter()
-        .with_min_len(CHUNK)
-        .map(|p| mvp * p.extend(1.0))
-        .collect()
+/// A vertex after transformation: its clip-space position, the clip planes it is outside of and,
+/// computed once per vertex rather than once per triangle corner, its snapped projection.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct XfVertex {
+    clip: Vec4,
+    outcode: u8,
+    projected: Projected,
 }
 
-/// Set up all triangles (in source order; clipped triangles may yield several).
-pub(crate) fn setup_all(triangles: &[[u32; 3]], clip: &[Vec4], vp: Viewport) -> Vec<SetupTri> {
-    let planes = ClipPlanes::new(
-        1.0 + 2.0 * GUARD_BAND_PX / vp.width as f32,
-        1.0 + 2.0 * GUARD_BAND_PX / vp.height as f32,
-    );
-    let chunks: Vec<Vec<SetupTri>> = triangles
-        .par_chunks(CHUNK)
-        .enumerate()
-        .map(|(c, chunk)| {
-            let mut out = Vec::with_capacity(chunk.len());
-            for (k, t) in chunk.iter().enumerate() {
-                setup_one((c * CHUNK + k) as u32, *t, clip, &planes, vp, &mut out);
+/// A projected vertex: Fx24_8 screen position, NDC depth and 1/w.
+#[derive(Debug, Clone, Copy, Default)]
+struct Projected {
+    v: [i32; 2],
+    z: f32,
+    inv_w: f32,
+}
+
+/// Perspective divide and viewport mapping; `None` behind the eye or for non-finite input.
+fn project(p: Vec4, vp: Viewport) -> Option<Projected> {
+    if p.w <= 0.0 || !p.is_finite() {
+        return None;
+    }
+    let iw = 1.0 / p.w;
+    let (nx, ny) = (p.x * iw, p.y * iw);
+    Some(Projected {
+        v: [
+            Fx24_8::from_px((nx * 0.5 + 0.5) * vp.width as f32).0,
+            Fx24_8::from_px((0.5 - ny * 0.5) * vp.height as f32).0,
+        ],
+        z: (p.z * iw).clamp(0.0, 1.0),
+        inv_w: iw,
+    })
+}
+
+/// Transform every position to clip space, classify it against the clip planes and project the
+/// ones inside all of them.
+pub(crate) fn transform(
+    positions: &[Vec3],
+    mvp: Mat4,
+    planes: &ClipPlanes,
+    vp: Viewport,
+) -> Vec<XfVertex> {
+    positions
+        .par_iter()
+        .with_min_len(4096)
+        .map(|p| {
+            let clip = mvp * p.extend(1.0);
+            let outcode = planes.outcode(clip);
+            let projected = if outcode == 0 {
+                project(clip, vp).unwrap_or_default()
+            } else {
+                Projected::default()
+            };
+            XfVertex {
+                clip,
+                outcode,
+                projected,
             }
-            out
         })
-        .collect();
-    chunks.concat()
+        .collect()
 }
 
 /// Set up one source triangle, pushing zero or more screen triangles.
 pub(crate) fn setup_one(
     index: u32,
     t: [u32; 3],
-    clip: &[Vec4],
+    xf: &[XfVertex],
     planes: &ClipPlanes,
     vp: Viewport,
     out: &mut Vec<SetupTri>,
 ) {
-    let corners = [
-        ClipVertex {
-            pos: clip[t[0] as usize],
-            bary: Vec3::X,
-        },
-        ClipVertex {
-            pos: clip[t[1] as usize],
-            bary: Vec3::Y,
-        },
-        ClipVertex {
-            pos: clip[t[2] as usize],
-            bary: Vec3::Z,
-        },
-    ];
-    let codes = corners.map(|c| planes.outcode(c.pos));
-    if codes[0] & codes[1] & codes[2] != 0 {
+    let [a, b, c] = t.map(|i| &xf[i as usize]);
+    if a.outcode & b.outcode & c.outcode != 0 {
         return; // entirely outside one plane
     }
-    if codes[0] | codes[1] | codes[2] == 0 {
-        emit(index, corners, vp, out);
+    const CORNERS: [Vec3; 3] = [Vec3::X, Vec3::Y, Vec3::Z];
+    if a.outcode | b.outcode | c.outcode == 0 {
+        emit(
+            index,
+            [a.projected, b.projected, c.projected],
+            CORNERS,
+            vp,
+            out,
+        );
         return;
     }
-    let poly = planes.clip_polygon(corners);
+    let corners = [a, b, c].map(|v| v.clip);
+    let poly = planes.clip_polygon([0, 1, 2].map(|i| ClipVertex {
+        pos: corners[i],
+        bary: CORNERS[i],
+    }));
+    let projected: Option<Vec<Projected>> = poly.iter().map(|p| project(p.pos, vp)).collect();
+    let Some(projected) = projected else { return };
     for k in 1..poly.len().saturating_sub(1) {
-        emit(index, [poly[0], poly[k], poly[k + 1]], vp, out);
+        let bary = [poly[0].bary, poly[k].bary, poly[k + 1].bary];
+        emit(
+            index,
+            [projected[0], projected[k], projected[k + 1]],
+            bary,
+            vp,
+            out,
+        );
     }
 }
 
-/// Project, snap, orient and bound one clipped triangle.
-fn emit(index: u32, c: [ClipVertex; 3], vp: Viewport, out: &mut Vec<SetupTri>) {
-    let (w, h) = (vp.width as f32, vp.height as f32);
-    let mut v = [[0i32; 2]; 3];
-    let mut z = [0f32; 3];
-    let mut inv_w = [0f32; 3];
-    for i in 0..3 {
-        let p = c[i].pos;
-        if p.w <= 0.0 || !p.is_finite() {
-            return;
-        }
-        let iw = 1.0 / p.w;
-        let (nx, ny) = (p.x * iw, p.y * iw);
-        v[i] = [
-            Fx24_8::from_px((nx * 0.5 + 0.5) * w).0,
-            Fx24_8::from_px((0.5 - ny * 0.5) * h).0,
-        ];
-        z[i] = (p.z * iw).clamp(0.0, 1.0);
-        inv_w[i] = iw;
-    }
-    let mut bary = [c[0].bary, c[1].bary, c[2].bary];
+/// Orient and bound one projected triangle.
+fn emit(index: u32, p: [Projected; 3], mut bary: [Vec3; 3], vp: Viewport, out: &mut Vec<SetupTri>) {
+    let mut v = p.map(|q| q.v);
+    let mut z = p.map(|q| q.z);
+    let mut inv_w = p.map(|q| q.inv_w);
     let e = |a: [i32; 2], b: [i32; 2], p: [i32; 2]| {
         (b[0] as i64 - a[0] as i64) * (p[1] as i64 - a[1] as i64)
             - (b[1] as i64 - a[1] as i64) * (p[0] as i64 - a[0] as i64)

@@ -20,6 +20,7 @@
 
 use glam::{Vec2, Vec3};
 
+use super::bin::Binned;
 use super::setup::SetupTri;
 use super::{PreparedMesh, Shading};
 use crate::mesh::Mesh;
@@ -29,7 +30,7 @@ use crate::mesh::Mesh;
 pub(crate) struct ShadeContext<'a> {
     pub mesh: &'a Mesh,
     pub prepared: &'a PreparedMesh,
-    pub setup: &'a [SetupTri],
+    pub setup: &'a Binned,
     pub shading: Shading,
     /// (unit direction towards the light, colour), world space.
     pub lights: Vec<(Vec3, Vec3)>,
@@ -87,7 +88,7 @@ impl ShadeContext<'_> {
 
     /// Shade set-up triangle `id` at screen point (x, y) (pixels).
     pub fn shade(&self, id: u32, x: f64, y: f64) -> Vec3 {
-        let st = &self.setup[id as usize];
+        let st = self.setup.get(id);
         let tri = self.mesh.triangles()[st.tri as usize].map(|i| i as usize);
         let (b, lambda) = self.barycentrics(st, x, y);
         let lerp3 = |a: &[Vec3]| a[tri[0]] * b.x + a[tri[1]] * b.y + a[tri[2]] * b.z;
