@@ -138,6 +138,9 @@ pub struct RasterBench {
     pub samples: Vec<u32>,
     /// Shading model.
     pub shading: raster::Shading,
+    /// Also write the scene (mesh and per-view matrices) here, for rendering the identical scene
+    /// with another renderer (`benches/llvmpipe_raster.py`).
+    pub export: Option<PathBuf>,
 }
 
 /// One line of the benchmark table.
@@ -167,6 +170,18 @@ pub fn bench_raster(b: &RasterBench) -> Result<Vec<RasterBenchRow>> {
     let mesh = Arc::new(crate::mesh::shapes::torus(b.rings, b.sides, 0.35));
     let scene = Scene::new(mesh.clone());
     let cameras = rig_cameras(&mesh, &Rig::Fibonacci(b.views), 1.0);
+    if let Some(dir) = &b.export {
+        export_scene(dir, &scene, &cameras)?;
+        // View 0 at 1 sample, to compare pictures with the other renderer's.
+        let mut one = RenderSettings::DEFAULT;
+        (one.width, one.height, one.shading) = (b.size, b.size, b.shading);
+        one.samples = raster::SamplePattern::Ordered(1);
+        write_frame(
+            &dir.join("lodeval-view0.png"),
+            &raster::render(&scene, &cameras[0], &one)?,
+            false,
+        )?;
+    }
     let mut rows = Vec::new();
     for &samples in &b.samples {
         let n = (samples as f64).sqrt().round() as u32;
@@ -202,4 +217,48 @@ pub fn peak_rss_mib() -> Option<f64> {
     let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
     let kib: f64 = line.split_whitespace().nth(1)?.parse().ok()?;
     Some(kib / 1024.0)
+}
+
+/// Write a scene as raw little-endian arrays plus a JSON list of views: `positions.f32`,
+/// `normals.f32` (xyz per vertex), `indices.u32` (three per triangle) and `views.json` with each
+/// view's column-major model-view-projection matrix (depth 0..1), unit light direction, light
+/// colour, direction towards the eye, ambient term and the material's Blinn–Phong parameters.
+pub fn export_scene(dir: &Path, scene: &Scene, cameras: &[Camera]) -> Result<()> {
+    let mesh = scene.mesh();
+    let floats = |v: &[glam::Vec3]| {
+        v.iter()
+            .flat_map(|p| p.to_array())
+            .flat_map(f32::to_le_bytes)
+            .collect::<Vec<u8>>()
+    };
+    crate::io::write_atomic(&dir.join("positions.f32"), &floats(mesh.positions()))?;
+    crate::io::write_atomic(&dir.join("normals.f32"), &floats(mesh.normals()))?;
+    let idx: Vec<u8> = mesh
+        .triangles()
+        .iter()
+        .flatten()
+        .flat_map(|i| i.to_le_bytes())
+        .collect();
+    crate::io::write_atomic(&dir.join("indices.u32"), &idx)?;
+    let m = &mesh.materials()[0];
+    let views: Vec<serde_json::Value> = cameras
+        .iter()
+        .map(|c| {
+            let mvp = c.projection(1.0) * c.view();
+            let (l, color) = scene.lights[0].resolve(c);
+            serde_json::json!({
+                "mvp": mvp.to_cols_array(),
+                "light_dir": l.to_array(),
+                "light_color": color.to_array(),
+                "to_eye": c.to_eye().to_array(),
+                "ambient": scene.ambient,
+                "base_color": m.base_color.to_array(),
+                "specular": m.specular.to_array(),
+                "shininess": m.shininess,
+                "background": scene.background.to_array(),
+            })
+        })
+        .collect();
+    let json = serde_json::to_string_pretty(&views).map_err(|e| Error::Internal(e.to_string()))?;
+    crate::io::write_atomic(&dir.join("views.json"), json.as_bytes())
 }

@@ -131,6 +131,9 @@ struct BenchArgs {
     /// Print JSON rows instead of a table.
     #[arg(long)]
     json: bool,
+    /// Also export the benchmark scene to this folder (for benches/llvmpipe_raster.py).
+    #[arg(long)]
+    export: Option<PathBuf>,
 }
 
 #[derive(Copy, Clone, Debug, ValueEnum)]
@@ -310,6 +313,7 @@ fn run(cli: Cli) -> Result<(), Error> {
                 views: a.views,
                 samples: a.samples,
                 shading,
+                export: a.export,
             };
             let rows = lodeval::commands::bench_raster(&job)?;
             let rss = lodeval::commands::peak_rss_mib().unwrap_or(f64::NAN);

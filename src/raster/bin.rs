@@ -90,17 +90,24 @@ pub(crate) fn setup_and_bin(
                 setup_one((c * CHUNK + k) as u32, *t, xf, planes, vp, &mut tris);
             }
             // Counting sort by tile: count, prefix-sum, scatter (keeps triangle order per tile).
-            let tiles_of = |t: &SetupTri| {
+            // Explicit loops: most triangles touch one tile, and nested iterator adapters here
+            // cost more than the counting itself.
+            let tile_range = |t: &SetupTri| {
                 let [x0, y0, x1, y1] = t.bbox;
-                let (tx0, ty0) = (x0 as u32 / TILE, y0 as u32 / TILE);
-                let (tx1, ty1) = ((x1 as u32 - 1) / TILE, (y1 as u32 - 1) / TILE);
-                (ty0..=ty1)
-                    .flat_map(move |ty| (tx0..=tx1).map(move |tx| (ty * tiles_x + tx) as usize))
+                [
+                    x0 as u32 / TILE,
+                    y0 as u32 / TILE,
+                    (x1 as u32 - 1) / TILE,
+                    (y1 as u32 - 1) / TILE,
+                ]
             };
             let mut tile_start = vec![0u32; n_tiles + 1];
             for t in &tris {
-                for tile in tiles_of(t) {
-                    tile_start[tile + 1] += 1;
+                let [tx0, ty0, tx1, ty1] = tile_range(t);
+                for ty in ty0..=ty1 {
+                    for tx in tx0..=tx1 {
+                        tile_start[(ty * tiles_x + tx) as usize + 1] += 1;
+                    }
                 }
             }
             for i in 0..n_tiles {
@@ -109,9 +116,13 @@ pub(crate) fn setup_and_bin(
             let mut fill = tile_start.clone();
             let mut items = vec![0u16; tile_start[n_tiles] as usize];
             for (k, t) in tris.iter().enumerate() {
-                for tile in tiles_of(t) {
-                    items[fill[tile] as usize] = k as u16;
-                    fill[tile] += 1;
+                let [tx0, ty0, tx1, ty1] = tile_range(t);
+                for ty in ty0..=ty1 {
+                    for tx in tx0..=tx1 {
+                        let tile = (ty * tiles_x + tx) as usize;
+                        items[fill[tile] as usize] = k as u16;
+                        fill[tile] += 1;
+                    }
                 }
             }
             SetupChunk {

@@ -111,7 +111,8 @@ mod tests {
         for p in &poly {
             assert!(p.pos.z >= -1e-6);
             // Barycentrics reproduce the position from the original corners.
-            let x = p.bary.x * 0.0 + p.bary.y * 1.0 + p.bary.z * -1.0;
+            // Corner x coordinates are 0, 1 and -1.
+            let x = p.bary.y - p.bary.z;
             assert!((x - p.pos.x).abs() < 1e-6);
             assert!((p.bary.x + p.bary.y + p.bary.z - 1.0).abs() < 1e-6);
         }

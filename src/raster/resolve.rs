@@ -20,7 +20,10 @@ pub(crate) struct Pass<'a> {
     binned: Binned,
     offsets: Vec<[i64; 2]>,
     count_coverage: bool,
-    ctx_parts: (Vec<(Vec3, Vec3)>, Vec3, (f32, f32, bool)),
+    /// Resolved lights (direction towards the light, colour).
+    lights: Vec<(Vec3, Vec3)>,
+    to_eye: Vec3,
+    depth_range: (f32, f32, bool),
 }
 
 /// A resolved tile.
@@ -58,7 +61,9 @@ impl<'a> Pass<'a> {
             binned,
             offsets: settings.samples.offsets(),
             count_coverage,
-            ctx_parts: (lights, camera.to_eye(), depth_range),
+            lights,
+            to_eye: camera.to_eye(),
+            depth_range,
         }
     }
 
@@ -68,11 +73,11 @@ impl<'a> Pass<'a> {
             prepared: self.scene.prepared(),
             setup: &self.binned,
             shading: self.settings.shading,
-            lights: self.ctx_parts.0.clone(),
-            to_eye: self.ctx_parts.1,
+            lights: self.lights.clone(),
+            to_eye: self.to_eye,
             ambient: self.scene.ambient,
             vertex_light: Vec::new(),
-            depth_range: self.ctx_parts.2,
+            depth_range: self.depth_range,
         };
         if ctx.shading == super::Shading::Gouraud {
             ctx.vertex_light = vertex_lighting(&ctx);

@@ -140,18 +140,16 @@ impl ShadeContext<'_> {
             }
             _ => {
                 let mut n = lerp3(self.mesh.normals()).normalize_or_zero();
-                if self.shading == Shading::NormalMapped {
-                    if let (Some(map), Some(tangents), Some((uv, dx, dy))) =
+                if self.shading == Shading::NormalMapped
+                    && let (Some(map), Some(tangents), Some((uv, dx, dy))) =
                         (&textures.normal, &self.prepared.tangents, uv_frame)
-                    {
-                        let t4 = tangents[tri[0]] * b.x
-                            + tangents[tri[1]] * b.y
-                            + tangents[tri[2]] * b.z;
-                        let t = (t4.truncate() - n * n.dot(t4.truncate())).normalize_or_zero();
-                        let bitangent = n.cross(t) * if t4.w < 0.0 { -1.0 } else { 1.0 };
-                        let m = map.sample(uv, dx, dy) * 2.0 - 1.0;
-                        n = (t * m.x + bitangent * m.y + n * m.z).normalize_or(n);
-                    }
+                {
+                    let t4 =
+                        tangents[tri[0]] * b.x + tangents[tri[1]] * b.y + tangents[tri[2]] * b.z;
+                    let t = (t4.truncate() - n * n.dot(t4.truncate())).normalize_or_zero();
+                    let bitangent = n.cross(t) * if t4.w < 0.0 { -1.0 } else { 1.0 };
+                    let m = map.sample(uv, dx, dy) * 2.0 - 1.0;
+                    n = (t * m.x + bitangent * m.y + n * m.z).normalize_or(n);
                 }
                 light_terms(
                     n,

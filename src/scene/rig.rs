@@ -14,10 +14,11 @@ use glam::Vec3;
 const PHI: f32 = 1.618_034;
 
 /// A set of view directions.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, Default)]
 #[non_exhaustive]
 pub enum Rig {
     /// The 20 vertices of a regular dodecahedron (the default).
+    #[default]
     Dodecahedron,
     /// The 12 vertices of a regular icosahedron.
     Icosahedron,
@@ -25,12 +26,6 @@ pub enum Rig {
     Fibonacci(u32),
     /// Explicit directions (each non-zero; normalised on use).
     Explicit(Vec<Vec3>),
-}
-
-impl Default for Rig {
-    fn default() -> Self {
-        Rig::Dodecahedron
-    }
 }
 
 impl Rig {
