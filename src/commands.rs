@@ -162,6 +162,9 @@ pub struct RasterBenchRow {
     pub frames_per_s: f64,
     /// Millions of triangles per second.
     pub mtri_per_s: f64,
+    /// Mean microseconds to re-render one 16×16-pixel rectangle of a kept frame
+    /// ([`raster::RegionRenderer::render_rect`]), over 256 rectangles across the object.
+    pub region_16_us: f64,
 }
 
 /// Render a procedural torus from every view and time it. Timing is for reporting only: nothing
@@ -197,7 +200,18 @@ pub fn bench_raster(b: &RasterBench) -> Result<Vec<RasterBenchRow>> {
             std::hint::black_box(raster::render(&scene, c, &settings)?);
         }
         let secs = start.elapsed().as_secs_f64() / cameras.len() as f64;
+        // Region re-render: 16×16 rectangles on a 16×16 grid over the middle of the image.
+        let mut region = raster::RegionRenderer::new(&scene, &cameras[0], &settings)?;
+        let step = (b.size / 2 / 16).max(1) as i32;
+        let origin = (b.size / 4) as i32;
+        let start = std::time::Instant::now();
+        for i in 0..256 {
+            let (x, y) = (origin + (i % 16) * step, origin + (i / 16) * step);
+            region.render_rect([x, y, x + 16, y + 16]);
+        }
+        let region_16_us = start.elapsed().as_secs_f64() / 256.0 * 1e6;
         rows.push(RasterBenchRow {
+            region_16_us,
             triangles: mesh.triangle_count(),
             size: b.size,
             samples: n * n,

@@ -323,10 +323,10 @@ fn run(cli: Cli) -> Result<(), Error> {
                     .map_err(|e| Error::Internal(e.to_string()))?
                     + "\n";
             } else {
-                text.push_str("| triangles | size | samples | views | threads | ms/frame | frames/s | Mtri/s |\n|---|---|---|---|---|---|---|---|\n");
+                text.push_str("| triangles | size | samples | views | threads | ms/frame | frames/s | Mtri/s | 16×16 region µs |\n|---|---|---|---|---|---|---|---|---|\n");
                 for r in &rows {
                     text.push_str(&format!(
-                        "| {} | {} | {} | {} | {} | {:.1} | {:.2} | {:.1} |\n",
+                        "| {} | {} | {} | {} | {} | {:.1} | {:.2} | {:.1} | {:.0} |\n",
                         r.triangles,
                         r.size,
                         r.samples,
@@ -334,7 +334,8 @@ fn run(cli: Cli) -> Result<(), Error> {
                         r.threads,
                         r.ms_per_frame,
                         r.frames_per_s,
-                        r.mtri_per_s
+                        r.mtri_per_s,
+                        r.region_16_us
                     ));
                 }
                 text.push_str(&format!("peak RSS: {rss:.0} MiB\n"));

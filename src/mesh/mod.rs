@@ -279,6 +279,22 @@ impl Mesh {
         })
     }
 
+    /// The mesh as plain data, for building an edited copy with [`Mesh::new`]. Normals are included
+    /// only if they came from the file, so generated ones are generated again for the new shape.
+    pub fn to_data(&self) -> MeshData {
+        MeshData {
+            positions: self.positions.clone(),
+            normals: self.normals_from_file.then(|| self.normals.clone()),
+            uvs: self.uvs.clone(),
+            colors: self.colors.clone(),
+            triangles: self.triangles.clone(),
+            material_ids: self.material_ids.clone(),
+            materials: self.materials.clone(),
+            source: self.source.clone(),
+            warnings: self.warnings.clone(),
+        }
+    }
+
     /// Vertex positions in model units.
     pub fn positions(&self) -> &[Vec3] {
         &self.positions

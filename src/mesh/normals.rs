@@ -146,7 +146,13 @@ pub(crate) fn normalize_given(
     positions: &[Vec3],
     triangles: &[[u32; 3]],
 ) -> Vec<Vec3> {
-    let mut out: Vec<Option<Vec3>> = given.iter().map(|n| n.try_normalize()).collect();
+    // Unit normals are kept bit for bit, so that rebuilding a mesh from its own data
+    // (`Mesh::to_data`) reproduces it exactly.
+    let unit = |n: &Vec3| (n.length_squared() - 1.0).abs() <= 4.0 * f32::EPSILON;
+    let mut out: Vec<Option<Vec3>> = given
+        .iter()
+        .map(|n| if unit(n) { Some(*n) } else { n.try_normalize() })
+        .collect();
     if out.iter().any(Option::is_none) {
         let mut tmp = MeshData {
             positions: positions.to_vec(),

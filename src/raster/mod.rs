@@ -22,6 +22,7 @@ mod edge;
 mod fixed;
 mod frame;
 mod prepare;
+mod region;
 mod resolve;
 mod setup;
 mod shade;
@@ -35,6 +36,7 @@ use crate::scene::{Camera, Projection, Scene};
 
 pub use frame::{Frame, NO_TRIANGLE, contact_sheet};
 pub use prepare::PreparedMesh;
+pub use region::RegionRenderer;
 pub use texture::MipTexture;
 
 /// Shading models, by the names a config or the CLI uses.
@@ -199,7 +201,7 @@ impl Default for RenderSettings {
 pub fn render(scene: &Scene, camera: &Camera, settings: &RenderSettings) -> Result<Frame> {
     settings.check()?;
     let pass = resolve::Pass::new(scene, camera, settings, false);
-    Ok(pass.resolve_frame())
+    Ok(pass.resolve_frame(&pass.context(None)))
 }
 
 /// Diagnostic: for every sample, how many triangles cover it (no depth test). A closed mesh seen

@@ -1,33 +1,42 @@
 //! One render pass: runs set-up and binning, rasterizes every tile in parallel, and resolves each
-//! tile's samples into pixels (shading once per distinct triangle per pixel, averaging in linear light).
+//! tile's samples into pixels (shading once per distinct triangle per pixel, averaging in linear
+//! light). The region re-render (`region.rs`) keeps a pass alive and reuses its pieces.
 
-use glam::Vec3;
+use std::borrow::Cow;
+
+use glam::{Mat4, Vec3};
 use rayon::prelude::*;
 
 use super::bin::{self, Binned};
 use super::clip::ClipPlanes;
 use super::edge::{self, EMPTY, TileSamples};
 use super::frame::{Frame, NO_TRIANGLE};
-use super::setup::{self, Viewport};
+use super::setup::{self, Viewport, XfVertex};
 use super::shade::ShadeContext;
-use super::{RenderSettings, camera_setup, vertex_lighting};
+use super::{RenderSettings, Shading, camera_setup, vertex_lighting};
 use crate::scene::{Camera, Scene};
 
 /// Set-up state of one frame.
-pub(crate) struct Pass<'a> {
-    scene: &'a Scene,
-    settings: RenderSettings,
-    binned: Binned,
-    offsets: Vec<[i64; 2]>,
+#[derive(Debug)]
+pub(crate) struct Pass {
+    pub scene: Scene,
+    pub settings: RenderSettings,
+    pub mvp: Mat4,
+    pub vp: Viewport,
+    pub planes: ClipPlanes,
+    pub xf: Vec<XfVertex>,
+    pub binned: Binned,
+    pub offsets: Vec<[i64; 2]>,
     count_coverage: bool,
     /// Resolved lights (direction towards the light, colour).
-    lights: Vec<(Vec3, Vec3)>,
-    to_eye: Vec3,
+    pub lights: Vec<(Vec3, Vec3)>,
+    pub to_eye: Vec3,
     depth_range: (f32, f32, bool),
 }
 
-/// A resolved tile.
-struct TileOut {
+/// Resolved pixels of a rectangle.
+#[derive(Debug)]
+pub(crate) struct Resolved {
     rect: [i32; 4],
     color: Vec<Vec3>,
     depth: Vec<f32>,
@@ -35,39 +44,43 @@ struct TileOut {
     triangle: Vec<u32>,
 }
 
-impl<'a> Pass<'a> {
+impl Pass {
     pub fn new(
-        scene: &'a Scene,
+        scene: &Scene,
         camera: &Camera,
         settings: &RenderSettings,
         count_coverage: bool,
-    ) -> Pass<'a> {
+    ) -> Pass {
         let mesh = scene.mesh();
         let (mvp, depth_range) = camera_setup(camera, settings.width, settings.height);
-        // Stage 1: transform and set up triangles.
         let vp = Viewport {
             width: settings.width,
             height: settings.height,
             cull_backfaces: settings.cull_backfaces,
         };
         let planes = ClipPlanes::for_viewport(settings.width, settings.height);
+        // Stage 1: transform, classify and project vertices.
         let xf = setup::transform(mesh.positions(), mvp, &planes, vp);
-        // Stage 2 (fused with set-up, per chunk): bin into tiles.
+        // Stage 2: set up triangles and bin them into tiles (fused, per chunk).
         let binned = bin::setup_and_bin(mesh.triangles(), &xf, &planes, vp);
-        let lights = scene.lights.iter().map(|l| l.resolve(camera)).collect();
         Pass {
-            scene,
+            scene: scene.clone(),
             settings: *settings,
+            mvp,
+            vp,
+            planes,
+            xf,
             binned,
             offsets: settings.samples.offsets(),
             count_coverage,
-            lights,
+            lights: scene.lights.iter().map(|l| l.resolve(camera)).collect(),
             to_eye: camera.to_eye(),
             depth_range,
         }
     }
 
-    fn context(&self) -> ShadeContext<'_> {
+    /// The shading context; for Gouraud, `vertex_light` is used if given, computed otherwise.
+    pub fn context<'a>(&'a self, vertex_light: Option<&'a [(Vec3, Vec3)]>) -> ShadeContext<'a> {
         let mut ctx = ShadeContext {
             mesh: self.scene.mesh(),
             prepared: self.scene.prepared(),
@@ -76,16 +89,19 @@ impl<'a> Pass<'a> {
             lights: self.lights.clone(),
             to_eye: self.to_eye,
             ambient: self.scene.ambient,
-            vertex_light: Vec::new(),
+            vertex_light: Cow::Borrowed(&[]),
             depth_range: self.depth_range,
         };
-        if ctx.shading == super::Shading::Gouraud {
-            ctx.vertex_light = vertex_lighting(&ctx);
+        if ctx.shading == Shading::Gouraud {
+            ctx.vertex_light = match vertex_light {
+                Some(v) => Cow::Borrowed(v),
+                None => Cow::Owned(vertex_lighting(&ctx)),
+            };
         }
         ctx
     }
 
-    /// Stage 3: scan-convert every triangle of tile `t` (in index order).
+    /// Stage 3: scan-convert every triangle of tile `t` (in source-triangle order).
     fn raster_tile(&self, t: usize) -> TileSamples {
         let rect = self
             .binned
@@ -98,13 +114,13 @@ impl<'a> Pass<'a> {
         buf
     }
 
-    /// Stage 4: resolve one tile's samples into pixels.
-    fn resolve_tile(&self, ctx: &ShadeContext, buf: &TileSamples) -> TileOut {
+    /// Stage 4: resolve a sample buffer into pixels.
+    pub fn resolve(&self, ctx: &ShadeContext, buf: &TileSamples) -> Resolved {
         let [x0, y0, x1, y1] = buf.rect;
         let n = ((x1 - x0) * (y1 - y0)) as usize;
         let s = buf.samples;
         let bg = self.scene.background;
-        let mut out = TileOut {
+        let mut out = Resolved {
             rect: buf.rect,
             color: Vec::with_capacity(n),
             depth: Vec::with_capacity(n),
@@ -131,15 +147,15 @@ impl<'a> Pass<'a> {
                         None => groups.push((id, k, 1)),
                     }
                 }
+                // Shade each triangle once, at its first covered sample (inside the triangle).
                 let mut color = bg * (empty as f32);
-                for &(id, first, _count) in &groups {
+                for &(id, first, count) in &groups {
                     let o = self.offsets[first];
                     let (sx, sy) = (
                         x as f64 + o[0] as f64 / 256.0,
                         y as f64 + o[1] as f64 / 256.0,
                     );
-                    let c = ctx.shade(id, sx, sy);
-                    color += c * (_count as f32);
+                    color += ctx.shade(id, sx, sy) * (count as f32);
                 }
                 // Most samples wins; on a tie the group seen first (earliest sample) stays.
                 let best = groups
@@ -159,11 +175,10 @@ impl<'a> Pass<'a> {
     }
 
     /// Rasterize and resolve every tile, then assemble the frame.
-    pub fn resolve_frame(&self) -> Frame {
-        let ctx = self.context();
-        let tiles: Vec<TileOut> = (0..self.binned.tile_count())
+    pub fn resolve_frame(&self, ctx: &ShadeContext) -> Frame {
+        let tiles: Vec<Resolved> = (0..self.binned.tile_count())
             .into_par_iter()
-            .map(|t| self.resolve_tile(&ctx, &self.raster_tile(t)))
+            .map(|t| self.resolve(ctx, &self.raster_tile(t)))
             .collect();
         let (w, h) = (self.settings.width, self.settings.height);
         let n = (w * h) as usize;
@@ -175,17 +190,8 @@ impl<'a> Pass<'a> {
             coverage: vec![0.0; n],
             triangle: vec![NO_TRIANGLE; n],
         };
-        for tile in tiles {
-            let [x0, y0, x1, y1] = tile.rect;
-            let tw = (x1 - x0) as usize;
-            for (r, y) in (y0..y1).enumerate() {
-                let dst = y as usize * w as usize + x0 as usize;
-                let src = r * tw;
-                frame.color[dst..dst + tw].copy_from_slice(&tile.color[src..src + tw]);
-                frame.depth[dst..dst + tw].copy_from_slice(&tile.depth[src..src + tw]);
-                frame.coverage[dst..dst + tw].copy_from_slice(&tile.coverage[src..src + tw]);
-                frame.triangle[dst..dst + tw].copy_from_slice(&tile.triangle[src..src + tw]);
-            }
+        for tile in &tiles {
+            blit(&mut frame, tile);
         }
         frame
     }
@@ -209,5 +215,20 @@ impl<'a> Pass<'a> {
             }
         }
         out
+    }
+}
+
+/// Copy resolved pixels into their place in a frame.
+pub(crate) fn blit(frame: &mut Frame, r: &Resolved) {
+    let [x0, y0, x1, y1] = r.rect;
+    let tw = (x1 - x0) as usize;
+    let w = frame.width as usize;
+    for (row, y) in (y0..y1).enumerate() {
+        let dst = y as usize * w + x0 as usize;
+        let src = row * tw;
+        frame.color[dst..dst + tw].copy_from_slice(&r.color[src..src + tw]);
+        frame.depth[dst..dst + tw].copy_from_slice(&r.depth[src..src + tw]);
+        frame.coverage[dst..dst + tw].copy_from_slice(&r.coverage[src..src + tw]);
+        frame.triangle[dst..dst + tw].copy_from_slice(&r.triangle[src..src + tw]);
     }
 }

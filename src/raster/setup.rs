@@ -92,21 +92,24 @@ pub(crate) fn transform(
     positions
         .par_iter()
         .with_min_len(4096)
-        .map(|p| {
-            let clip = mvp * p.extend(1.0);
-            let outcode = planes.outcode(clip);
-            let projected = if outcode == 0 {
-                project(clip, vp).unwrap_or_default()
-            } else {
-                Projected::default()
-            };
-            XfVertex {
-                clip,
-                outcode,
-                projected,
-            }
-        })
+        .map(|&p| transform_one(p, mvp, planes, vp))
         .collect()
+}
+
+/// Transform, classify and (if inside all planes) project one position.
+pub(crate) fn transform_one(p: Vec3, mvp: Mat4, planes: &ClipPlanes, vp: Viewport) -> XfVertex {
+    let clip = mvp * p.extend(1.0);
+    let outcode = planes.outcode(clip);
+    let projected = if outcode == 0 {
+        project(clip, vp).unwrap_or_default()
+    } else {
+        Projected::default()
+    };
+    XfVertex {
+        clip,
+        outcode,
+        projected,
+    }
 }
 
 /// Set up one source triangle, pushing zero or more screen triangles.

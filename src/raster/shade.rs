@@ -37,8 +37,8 @@ pub(crate) struct ShadeContext<'a> {
     /// Unit direction towards the (infinite) viewer.
     pub to_eye: Vec3,
     pub ambient: f32,
-    /// Per-vertex (diffuse light, specular) terms for `gouraud`.
-    pub vertex_light: Vec<(Vec3, Vec3)>,
+    /// Per-vertex (diffuse light, specular) terms for `gouraud` (borrowed by region updates).
+    pub vertex_light: std::borrow::Cow<'a, [(Vec3, Vec3)]>,
     /// Near and far distances and whether the projection is perspective (for the depth view).
     pub depth_range: (f32, f32, bool),
 }

@@ -1,0 +1,36 @@
+//! `cargo bench --bench raster`: the rasterizer benchmark of `lodeval bench raster` (1M-triangle
+//! torus, 20 views, 1024², 1 and 4 samples, plus 16×16 region re-renders), printed as a table.
+//! Figures go to results/BENCHMARKS.md; the side-by-side run with llvmpipe is
+//! benches/raster_vs_llvmpipe.sh.
+
+use lodeval::commands::{RasterBench, bench_raster};
+use lodeval::raster::Shading;
+
+fn main() {
+    let job = RasterBench {
+        rings: 1000,
+        sides: 500,
+        size: 1024,
+        views: 20,
+        samples: vec![1, 4],
+        shading: Shading::Gouraud,
+        export: None,
+    };
+    println!(
+        "| triangles | size | samples | views | threads | ms/frame | Mtri/s | 16×16 region µs |"
+    );
+    println!("|---|---|---|---|---|---|---|---|");
+    for r in bench_raster(&job).expect("benchmark runs") {
+        println!(
+            "| {} | {} | {} | {} | {} | {:.1} | {:.1} | {:.0} |",
+            r.triangles,
+            r.size,
+            r.samples,
+            r.views,
+            r.threads,
+            r.ms_per_frame,
+            r.mtri_per_s,
+            r.region_16_us
+        );
+    }
+}
