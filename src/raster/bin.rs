@@ -148,12 +148,13 @@ impl Binned {
     /// without stale ones (the overlay is reached through [`Binned::candidates`]).
     pub fn tile(&self, t: usize) -> impl Iterator<Item = (u32, &SetupTri)> {
         let stale = &self.stale;
+        let none_stale = stale.is_empty();
         self.chunks.iter().enumerate().flat_map(move |(c, chunk)| {
             let range = chunk.tile_start[t] as usize..chunk.tile_start[t + 1] as usize;
             chunk.items[range]
                 .iter()
                 .map(move |&k| (((c as u32) << 16) | k as u32, &chunk.tris[k as usize]))
-                .filter(move |(_, st)| !stale.get(st.tri as usize).copied().unwrap_or(false))
+                .filter(move |(_, st)| none_stale || !stale[st.tri as usize])
         })
     }
 }

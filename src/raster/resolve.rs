@@ -174,25 +174,45 @@ impl Pass {
         out
     }
 
-    /// Rasterize and resolve every tile, then assemble the frame.
+    /// Rasterize and resolve every tile (tiles in parallel), then copy each band of tile rows into
+    /// the frame (bands in parallel; every pixel written exactly once).
     pub fn resolve_frame(&self, ctx: &ShadeContext) -> Frame {
+        let (w, h) = (self.settings.width as usize, self.settings.height as usize);
+        let n = w * h;
         let tiles: Vec<Resolved> = (0..self.binned.tile_count())
             .into_par_iter()
             .map(|t| self.resolve(ctx, &self.raster_tile(t)))
             .collect();
-        let (w, h) = (self.settings.width, self.settings.height);
-        let n = (w * h) as usize;
         let mut frame = Frame {
-            width: w,
-            height: h,
+            width: w as u32,
+            height: h as u32,
             color: vec![Vec3::ZERO; n],
             depth: vec![f32::INFINITY; n],
             coverage: vec![0.0; n],
             triangle: vec![NO_TRIANGLE; n],
         };
-        for tile in &tiles {
-            blit(&mut frame, tile);
-        }
+        let band = bin::TILE as usize * w;
+        let tiles_x = (w as u32).div_ceil(bin::TILE) as usize;
+        frame
+            .color
+            .par_chunks_mut(band)
+            .zip(frame.depth.par_chunks_mut(band))
+            .zip(frame.coverage.par_chunks_mut(band))
+            .zip(frame.triangle.par_chunks_mut(band))
+            .zip(tiles.par_chunks(tiles_x))
+            .enumerate()
+            .for_each(|(ty, ((((color, depth), coverage), triangle), row))| {
+                let y0 = ty as i32 * bin::TILE as i32;
+                let mut out = PixelsMut {
+                    color,
+                    depth,
+                    coverage,
+                    triangle,
+                    width: w,
+                    y0,
+                };
+                row.iter().for_each(|tile| out.put(tile));
+            });
         frame
     }
 
@@ -218,17 +238,42 @@ impl Pass {
     }
 }
 
+/// Mutable frame channels for the rows starting at `y0`.
+struct PixelsMut<'a> {
+    color: &'a mut [Vec3],
+    depth: &'a mut [f32],
+    coverage: &'a mut [f32],
+    triangle: &'a mut [u32],
+    width: usize,
+    y0: i32,
+}
+
+impl PixelsMut<'_> {
+    /// Copy resolved pixels into their place.
+    fn put(&mut self, r: &Resolved) {
+        let [x0, y0, x1, y1] = r.rect;
+        let tw = (x1 - x0) as usize;
+        for (row, y) in (y0..y1).enumerate() {
+            let dst = (y - self.y0) as usize * self.width + x0 as usize;
+            let src = row * tw;
+            self.color[dst..dst + tw].copy_from_slice(&r.color[src..src + tw]);
+            self.depth[dst..dst + tw].copy_from_slice(&r.depth[src..src + tw]);
+            self.coverage[dst..dst + tw].copy_from_slice(&r.coverage[src..src + tw]);
+            self.triangle[dst..dst + tw].copy_from_slice(&r.triangle[src..src + tw]);
+        }
+    }
+}
+
 /// Copy resolved pixels into their place in a frame.
 pub(crate) fn blit(frame: &mut Frame, r: &Resolved) {
-    let [x0, y0, x1, y1] = r.rect;
-    let tw = (x1 - x0) as usize;
-    let w = frame.width as usize;
-    for (row, y) in (y0..y1).enumerate() {
-        let dst = y as usize * w + x0 as usize;
-        let src = row * tw;
-        frame.color[dst..dst + tw].copy_from_slice(&r.color[src..src + tw]);
-        frame.depth[dst..dst + tw].copy_from_slice(&r.depth[src..src + tw]);
-        frame.coverage[dst..dst + tw].copy_from_slice(&r.coverage[src..src + tw]);
-        frame.triangle[dst..dst + tw].copy_from_slice(&r.triangle[src..src + tw]);
+    let width = frame.width as usize;
+    PixelsMut {
+        color: &mut frame.color,
+        depth: &mut frame.depth,
+        coverage: &mut frame.coverage,
+        triangle: &mut frame.triangle,
+        width,
+        y0: 0,
     }
+    .put(r);
 }

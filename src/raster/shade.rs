@@ -68,21 +68,23 @@ pub(crate) fn light_terms(
 impl ShadeContext<'_> {
     /// Source-triangle barycentrics at screen point (x, y) in pixels, and the screen-space ones.
     fn barycentrics(&self, st: &SetupTri, x: f64, y: f64) -> (Vec3, [f64; 3]) {
-        let p = st.v.map(|q| [q[0] as f64 / 256.0, q[1] as f64 / 256.0]);
-        let area = st.area as f64 / 65536.0;
-        let mut lambda = [0f64; 3];
-        for (i, l) in lambda.iter_mut().enumerate() {
-            let (a, b) = (p[(i + 1) % 3], p[(i + 2) % 3]);
-            *l = ((b[0] - a[0]) * (y - a[1]) - (b[1] - a[1]) * (x - a[0])) / area;
-        }
-        let mu: Vec<f64> = (0..3).map(|i| lambda[i] * st.inv_w[i] as f64).collect();
+        // Fixed-point corners in pixels; λ_i = E_i(x, y) / area (both in px²).
+        let p =
+            st.v.map(|q| [q[0] as f64 * (1.0 / 256.0), q[1] as f64 * (1.0 / 256.0)]);
+        let inv_area = 65536.0 / st.area as f64;
+        let edge = |a: [f64; 2], b: [f64; 2]| {
+            ((b[0] - a[0]) * (y - a[1]) - (b[1] - a[1]) * (x - a[0])) * inv_area
+        };
+        let lambda = [edge(p[1], p[2]), edge(p[2], p[0]), edge(p[0], p[1])];
+        // Perspective correction: weight by 1/w and renormalise.
+        let mu = [0, 1, 2].map(|i| lambda[i] * st.inv_w[i] as f64);
         let sum = mu[0] + mu[1] + mu[2];
         let mu = if sum != 0.0 {
-            [mu[0] / sum, mu[1] / sum, mu[2] / sum]
+            mu.map(|m| (m / sum) as f32)
         } else {
             [1.0 / 3.0; 3]
         };
-        let b = st.bary[0] * mu[0] as f32 + st.bary[1] * mu[1] as f32 + st.bary[2] * mu[2] as f32;
+        let b = st.bary[0] * mu[0] + st.bary[1] * mu[1] + st.bary[2] * mu[2];
         (b, lambda)
     }
 
