@@ -14,10 +14,11 @@
 
 use std::collections::BTreeMap;
 
+use glam::Vec3;
 use rayon::prelude::*;
 
 use super::clip::ClipPlanes;
-use super::setup::{SetupTri, Viewport, XfVertex, setup_one};
+use super::setup::{SetupOut, SetupTri, Viewport, XfVertex, corner_barycentrics, setup_one};
 
 /// Tile edge in pixels.
 pub const TILE: u32 = 64;
@@ -28,6 +29,7 @@ const CHUNK: usize = 4096;
 #[derive(Debug, Clone)]
 pub(crate) struct SetupChunk {
     tris: Vec<SetupTri>,
+    clipped: Vec<[Vec3; 3]>,
     /// `items[tile_start[t]..tile_start[t + 1]]` are the triangles (indices into `tris`) of tile t.
     tile_start: Vec<u32>,
     items: Vec<u16>,
@@ -43,7 +45,7 @@ pub(crate) struct Binned {
     tiles_x: u32,
     n_tiles: usize,
     /// Set-up triangles that replace stale source triangles; ids are `OVERLAY | index`.
-    overlay: Vec<SetupTri>,
+    overlay: SetupOut,
     /// Per source triangle: its entries in `chunks` are stale (replaced). Empty until the first
     /// replacement.
     stale: Vec<bool>,
@@ -55,9 +57,15 @@ impl Binned {
     /// The set-up triangle with id `id`.
     pub fn get(&self, id: u32) -> &SetupTri {
         if id & OVERLAY != 0 {
-            return &self.overlay[(id & !OVERLAY) as usize];
+            return &self.overlay.tris[(id & !OVERLAY) as usize];
         }
         &self.chunks[(id >> 16) as usize].tris[(id & 0xFFFF) as usize]
+    }
+
+    /// Barycentrics of the corners of set-up triangle `id` with respect to its source triangle.
+    pub fn corner_barycentrics(&self, id: u32) -> [Vec3; 3] {
+        let clipped = if id & OVERLAY != 0 { &self.overlay.clipped } else { &self.chunks[(id >> 16) as usize].clipped };
+        corner_barycentrics(self.get(id).corners, clipped)
     }
 
     fn is_stale(&self, src: u32) -> bool {
@@ -81,17 +89,16 @@ impl Binned {
             .collect()
     }
 
-    /// Replace the set-up of source triangle `src` (of `source_count`) by `new`.
-    pub fn replace(&mut self, src: u32, new: Vec<SetupTri>, source_count: usize) {
+    /// Set up source triangle `src` (of `source_count`) anew with `setup`, which appends to the
+    /// overlay; its old entries become stale.
+    pub fn replace(&mut self, src: u32, source_count: usize, setup: impl FnOnce(&mut SetupOut)) {
         if self.stale.is_empty() {
             self.stale = vec![false; source_count];
         }
         self.stale[src as usize] = true;
-        let first = self.overlay.len() as u32;
-        let ids = (first..first + new.len() as u32)
-            .map(|i| OVERLAY | i)
-            .collect();
-        self.overlay.extend(new);
+        let first = self.overlay.tris.len() as u32;
+        setup(&mut self.overlay);
+        let ids = (first..self.overlay.tris.len() as u32).map(|i| OVERLAY | i).collect();
         self.overlay_of.insert(src, ids);
     }
 
@@ -172,10 +179,11 @@ pub(crate) fn setup_and_bin(
         .par_chunks(CHUNK)
         .enumerate()
         .map(|(c, chunk)| {
-            let mut tris = Vec::with_capacity(chunk.len());
+            let mut out = SetupOut { tris: Vec::with_capacity(chunk.len()), clipped: Vec::new() };
             for (k, t) in chunk.iter().enumerate() {
-                setup_one((c * CHUNK + k) as u32, *t, xf, planes, vp, &mut tris);
+                setup_one((c * CHUNK + k) as u32, *t, xf, planes, vp, &mut out);
             }
+            let SetupOut { tris, clipped } = out;
             // Counting sort by tile: count, prefix-sum, scatter (keeps triangle order per tile).
             // Explicit loops: most triangles touch one tile, and nested iterator adapters here
             // cost more than the counting itself.
@@ -214,6 +222,7 @@ pub(crate) fn setup_and_bin(
             }
             SetupChunk {
                 tris,
+                clipped,
                 tile_start,
                 items,
             }
@@ -223,7 +232,7 @@ pub(crate) fn setup_and_bin(
         chunks,
         tiles_x,
         n_tiles,
-        overlay: Vec::new(),
+        overlay: SetupOut::default(),
         stale: Vec::new(),
         overlay_of: BTreeMap::new(),
     }

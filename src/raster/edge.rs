@@ -89,6 +89,30 @@ pub(crate) fn rasterize(
             so[i] = coef[i][0] * o[0] + coef[i][1] * o[1] + bias[i];
         }
     }
+    // The common sample counts get a loop the compiler can unroll (1 and 4 samples).
+    match s {
+        1 => scan::<1>(st, id, [x0, y0, x1, y1], origin, coef, bias, sample_off, buf),
+        4 => scan::<4>(st, id, [x0, y0, x1, y1], origin, coef, bias, sample_off, buf),
+        _ => scan::<0>(st, id, [x0, y0, x1, y1], origin, coef, bias, sample_off, buf),
+    }
+}
+
+/// The pixel loop of [`rasterize`]; `S` is the sample count, or 0 for "read it from the slice".
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+fn scan<const S: usize>(
+    st: &SetupTri,
+    id: u32,
+    [x0, y0, x1, y1]: [i32; 4],
+    origin: [i64; 3],
+    coef: [[i64; 2]; 3],
+    bias: [i64; 3],
+    sample_off: &[[i64; 3]],
+    buf: &mut TileSamples,
+) {
+    let one = super::fixed::ONE_PIXEL;
+    let s = if S == 0 { sample_off.len() } else { S };
+    let sample_off = &sample_off[..s];
     let inv_area = 1.0 / st.area as f64;
     let z = st.z.map(|v| v as f64);
     let tile_w = (buf.rect[2] - buf.rect[0]) as usize;
@@ -108,11 +132,7 @@ pub(crate) fn rasterize(
                     c[slot] = c[slot].saturating_add(1);
                 }
                 // Unbiased values give the barycentric weights.
-                let (w0, w1, w2) = (
-                    (e0 - bias[0]) as f64,
-                    (e1 - bias[1]) as f64,
-                    (e2 - bias[2]) as f64,
-                );
+                let (w0, w1, w2) = ((e0 - bias[0]) as f64, (e1 - bias[1]) as f64, (e2 - bias[2]) as f64);
                 let depth = ((w0 * z[0] + w1 * z[1] + w2 * z[2]) * inv_area) as f32;
                 if depth < buf.depth[slot] {
                     buf.depth[slot] = depth;

@@ -120,19 +120,12 @@ impl RegionRenderer {
         }
         // New set-up of the changed triangles, into the overlay.
         for &t in changed {
-            let mut tris = Vec::new();
-            setup_one(
-                t,
-                new.triangles()[t as usize],
-                &self.pass.xf,
-                &planes,
-                vp,
-                &mut tris,
-            );
-            for st in &tris {
-                grow(st.bbox);
+            let xf = &self.pass.xf;
+            let corners = new.triangles()[t as usize];
+            self.pass.binned.replace(t, new.triangle_count(), |out| setup_one(t, corners, xf, &planes, vp, out));
+            for id in self.pass.binned.ids_of(t) {
+                grow(self.pass.binned.get(id).bbox);
             }
-            self.pass.binned.replace(t, tris, new.triangle_count());
         }
         if let Some(rect) = dirty {
             self.render_rect(rect);

@@ -29,14 +29,40 @@ pub(crate) struct SetupTri {
     pub z: [f32; 3],
     /// 1/w per corner (perspective-correct interpolation).
     pub inv_w: [f32; 3],
-    /// Barycentrics of each corner with respect to the source triangle's vertices.
-    pub bary: [Vec3; 3],
+    /// Barycentrics of the corners with respect to the source triangle's vertices, coded (a
+    /// clipped corner set would triple the record, and the record's size is the rasterizer's
+    /// memory traffic): [`CORNERS_SOURCE`], [`CORNERS_SWAPPED`], or `CORNERS_CLIPPED + k` for
+    /// entry k of the owner's clipped-corner table ([`SetupOut::clipped`]).
+    pub corners: u32,
     /// Source triangle index.
     pub tri: u32,
     /// Whether the source triangle faces the camera.
     pub front: bool,
     /// Covered pixel rectangle `[x0, y0, x1, y1)`.
     pub bbox: [i32; 4],
+}
+
+/// The corners are the source triangle's vertices 0, 1, 2.
+pub(crate) const CORNERS_SOURCE: u32 = 0;
+/// The corners are the source triangle's vertices 0, 2, 1 (reordered to positive area).
+pub(crate) const CORNERS_SWAPPED: u32 = 1;
+/// First code of a clipped corner set.
+pub(crate) const CORNERS_CLIPPED: u32 = 2;
+
+/// Decode [`SetupTri::corners`] given the owner's clipped-corner table.
+pub(crate) fn corner_barycentrics(code: u32, clipped: &[[Vec3; 3]]) -> [Vec3; 3] {
+    match code {
+        CORNERS_SOURCE => [Vec3::X, Vec3::Y, Vec3::Z],
+        CORNERS_SWAPPED => [Vec3::X, Vec3::Z, Vec3::Y],
+        k => clipped[(k - CORNERS_CLIPPED) as usize],
+    }
+}
+
+/// Where set-up writes: the triangles and the corner barycentrics of clipped ones.
+#[derive(Debug, Clone, Default)]
+pub(crate) struct SetupOut {
+    pub tris: Vec<SetupTri>,
+    pub clipped: Vec<[Vec3; 3]>,
 }
 
 /// Viewport parameters for set-up.
@@ -119,7 +145,7 @@ pub(crate) fn setup_one(
     xf: &[XfVertex],
     planes: &ClipPlanes,
     vp: Viewport,
-    out: &mut Vec<SetupTri>,
+    out: &mut SetupOut,
 ) {
     let [a, b, c] = t.map(|i| &xf[i as usize]);
     if a.outcode & b.outcode & c.outcode != 0 {
@@ -127,13 +153,7 @@ pub(crate) fn setup_one(
     }
     const CORNERS: [Vec3; 3] = [Vec3::X, Vec3::Y, Vec3::Z];
     if a.outcode | b.outcode | c.outcode == 0 {
-        emit(
-            index,
-            [a.projected, b.projected, c.projected],
-            CORNERS,
-            vp,
-            out,
-        );
+        emit(index, [a.projected, b.projected, c.projected], None, vp, out);
         return;
     }
     let corners = [a, b, c].map(|v| v.clip);
@@ -145,18 +165,12 @@ pub(crate) fn setup_one(
     let Some(projected) = projected else { return };
     for k in 1..poly.len().saturating_sub(1) {
         let bary = [poly[0].bary, poly[k].bary, poly[k + 1].bary];
-        emit(
-            index,
-            [projected[0], projected[k], projected[k + 1]],
-            bary,
-            vp,
-            out,
-        );
+        emit(index, [projected[0], projected[k], projected[k + 1]], Some(bary), vp, out);
     }
 }
 
-/// Orient and bound one projected triangle.
-fn emit(index: u32, p: [Projected; 3], mut bary: [Vec3; 3], vp: Viewport, out: &mut Vec<SetupTri>) {
+/// Orient and bound one projected triangle; `bary` are its corners' barycentrics when clipped.
+fn emit(index: u32, p: [Projected; 3], mut bary: Option<[Vec3; 3]>, vp: Viewport, out: &mut SetupOut) {
     let mut v = p.map(|q| q.v);
     let mut z = p.map(|q| q.z);
     let mut inv_w = p.map(|q| q.inv_w);
@@ -176,7 +190,9 @@ fn emit(index: u32, p: [Projected; 3], mut bary: [Vec3; 3], vp: Viewport, out: &
         v.swap(1, 2);
         z.swap(1, 2);
         inv_w.swap(1, 2);
-        bary.swap(1, 2);
+        if let Some(b) = bary.as_mut() {
+            b.swap(1, 2);
+        }
         area = -area;
     }
     let min_x = v.iter().map(|p| p[0]).min().unwrap_or(0);
@@ -193,12 +209,20 @@ fn emit(index: u32, p: [Projected; 3], mut bary: [Vec3; 3], vp: Viewport, out: &
     if bbox[0] >= bbox[2] || bbox[1] >= bbox[3] {
         return;
     }
-    out.push(SetupTri {
+    let corners = match bary {
+        None if front => CORNERS_SWAPPED,
+        None => CORNERS_SOURCE,
+        Some(b) => {
+            out.clipped.push(b);
+            CORNERS_CLIPPED + out.clipped.len() as u32 - 1
+        }
+    };
+    out.tris.push(SetupTri {
         v,
         area,
         z,
         inv_w,
-        bary,
+        corners,
         tri: index,
         front,
         bbox,

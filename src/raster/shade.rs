@@ -67,7 +67,7 @@ pub(crate) fn light_terms(
 
 impl ShadeContext<'_> {
     /// Source-triangle barycentrics at screen point (x, y) in pixels, and the screen-space ones.
-    fn barycentrics(&self, st: &SetupTri, x: f64, y: f64) -> (Vec3, [f64; 3]) {
+    fn barycentrics(&self, st: &SetupTri, corners: &[Vec3; 3], x: f64, y: f64) -> (Vec3, [f64; 3]) {
         // Fixed-point corners in pixels; λ_i = E_i(x, y) / area (both in px²).
         let p =
             st.v.map(|q| [q[0] as f64 * (1.0 / 256.0), q[1] as f64 * (1.0 / 256.0)]);
@@ -84,15 +84,16 @@ impl ShadeContext<'_> {
         } else {
             [1.0 / 3.0; 3]
         };
-        let b = st.bary[0] * mu[0] + st.bary[1] * mu[1] + st.bary[2] * mu[2];
+        let b = corners[0] * mu[0] + corners[1] * mu[1] + corners[2] * mu[2];
         (b, lambda)
     }
 
     /// Shade set-up triangle `id` at screen point (x, y) (pixels).
     pub fn shade(&self, id: u32, x: f64, y: f64) -> Vec3 {
         let st = self.setup.get(id);
+        let corners = self.setup.corner_barycentrics(id);
         let tri = self.mesh.triangles()[st.tri as usize].map(|i| i as usize);
-        let (b, lambda) = self.barycentrics(st, x, y);
+        let (b, lambda) = self.barycentrics(st, &corners, x, y);
         let lerp3 = |a: &[Vec3]| a[tri[0]] * b.x + a[tri[1]] * b.y + a[tri[2]] * b.z;
         let material_id = self.mesh.material_ids()[st.tri as usize] as usize;
         let material = &self.mesh.materials()[material_id];
@@ -118,8 +119,8 @@ impl ShadeContext<'_> {
             |bb: Vec3, uvs: &[Vec2]| uvs[tri[0]] * bb.x + uvs[tri[1]] * bb.y + uvs[tri[2]] * bb.z;
         let uv_frame = self.mesh.uvs().map(|uvs| {
             let uv = uv_at(b, uvs);
-            let dx = uv_at(self.barycentrics(st, x + 1.0, y).0, uvs) - uv;
-            let dy = uv_at(self.barycentrics(st, x, y + 1.0).0, uvs) - uv;
+            let dx = uv_at(self.barycentrics(st, &corners, x + 1.0, y).0, uvs) - uv;
+            let dy = uv_at(self.barycentrics(st, &corners, x, y + 1.0).0, uvs) - uv;
             (uv, dx, dy)
         });
         let mut albedo = material.base_color;
