@@ -64,7 +64,11 @@ impl Binned {
 
     /// Barycentrics of the corners of set-up triangle `id` with respect to its source triangle.
     pub fn corner_barycentrics(&self, id: u32) -> [Vec3; 3] {
-        let clipped = if id & OVERLAY != 0 { &self.overlay.clipped } else { &self.chunks[(id >> 16) as usize].clipped };
+        let clipped = if id & OVERLAY != 0 {
+            &self.overlay.clipped
+        } else {
+            &self.chunks[(id >> 16) as usize].clipped
+        };
         corner_barycentrics(self.get(id).corners, clipped)
     }
 
@@ -98,7 +102,9 @@ impl Binned {
         self.stale[src as usize] = true;
         let first = self.overlay.tris.len() as u32;
         setup(&mut self.overlay);
-        let ids = (first..self.overlay.tris.len() as u32).map(|i| OVERLAY | i).collect();
+        let ids = (first..self.overlay.tris.len() as u32)
+            .map(|i| OVERLAY | i)
+            .collect();
         self.overlay_of.insert(src, ids);
     }
 
@@ -179,7 +185,10 @@ pub(crate) fn setup_and_bin(
         .par_chunks(CHUNK)
         .enumerate()
         .map(|(c, chunk)| {
-            let mut out = SetupOut { tris: Vec::with_capacity(chunk.len()), clipped: Vec::new() };
+            let mut out = SetupOut {
+                tris: Vec::with_capacity(chunk.len()),
+                clipped: Vec::new(),
+            };
             for (k, t) in chunk.iter().enumerate() {
                 setup_one((c * CHUNK + k) as u32, *t, xf, planes, vp, &mut out);
             }

@@ -23,6 +23,7 @@ pub(crate) struct ClipVertex {
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct ClipPlanes {
     planes: [Vec4; 6],
+    guard: [f32; 2],
 }
 
 impl ClipPlanes {
@@ -38,6 +39,7 @@ impl ClipPlanes {
                 Vec4::new(0.0, -1.0, 0.0, guard_ndc_y),
                 Vec4::new(0.0, 1.0, 0.0, guard_ndc_y),
             ],
+            guard: [guard_ndc_x, guard_ndc_y],
         }
     }
 
@@ -48,14 +50,15 @@ impl ClipPlanes {
     }
 
     /// Bit mask of the planes a point is outside of.
+    /// (The planes' dot products written out: every vertex of every frame goes through this.)
     pub fn outcode(&self, p: Vec4) -> u8 {
-        let mut code = 0;
-        for (i, plane) in self.planes.iter().enumerate() {
-            if plane.dot(p) < 0.0 {
-                code |= 1 << i;
-            }
-        }
-        code
+        let (gx, gy) = (self.guard[0] * p.w, self.guard[1] * p.w);
+        (p.z < 0.0) as u8
+            | ((p.w - p.z < 0.0) as u8) << 1
+            | ((gx - p.x < 0.0) as u8) << 2
+            | ((p.x + gx < 0.0) as u8) << 3
+            | ((gy - p.y < 0.0) as u8) << 4
+            | ((p.y + gy < 0.0) as u8) << 5
     }
 
     /// Clip a triangle given as three vertices whose outcodes are not all zero and share no bit.

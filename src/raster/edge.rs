@@ -91,9 +91,36 @@ pub(crate) fn rasterize(
     }
     // The common sample counts get a loop the compiler can unroll (1 and 4 samples).
     match s {
-        1 => scan::<1>(st, id, [x0, y0, x1, y1], origin, coef, bias, sample_off, buf),
-        4 => scan::<4>(st, id, [x0, y0, x1, y1], origin, coef, bias, sample_off, buf),
-        _ => scan::<0>(st, id, [x0, y0, x1, y1], origin, coef, bias, sample_off, buf),
+        1 => scan::<1>(
+            st,
+            id,
+            [x0, y0, x1, y1],
+            origin,
+            coef,
+            bias,
+            sample_off,
+            buf,
+        ),
+        4 => scan::<4>(
+            st,
+            id,
+            [x0, y0, x1, y1],
+            origin,
+            coef,
+            bias,
+            sample_off,
+            buf,
+        ),
+        _ => scan::<0>(
+            st,
+            id,
+            [x0, y0, x1, y1],
+            origin,
+            coef,
+            bias,
+            sample_off,
+            buf,
+        ),
     }
 }
 
@@ -132,7 +159,11 @@ fn scan<const S: usize>(
                     c[slot] = c[slot].saturating_add(1);
                 }
                 // Unbiased values give the barycentric weights.
-                let (w0, w1, w2) = ((e0 - bias[0]) as f64, (e1 - bias[1]) as f64, (e2 - bias[2]) as f64);
+                let (w0, w1, w2) = (
+                    (e0 - bias[0]) as f64,
+                    (e1 - bias[1]) as f64,
+                    (e2 - bias[2]) as f64,
+                );
                 let depth = ((w0 * z[0] + w1 * z[1] + w2 * z[2]) * inv_area) as f32;
                 if depth < buf.depth[slot] {
                     buf.depth[slot] = depth;

@@ -245,14 +245,7 @@ fn vertex_lighting(ctx: &shade::ShadeContext) -> Vec<(glam::Vec3, glam::Vec3)> {
         .with_min_len(4096)
         .map(|(v, &n)| {
             let m = &materials[ctx.prepared.vertex_material[v] as usize];
-            shade::light_terms(
-                n,
-                &ctx.lights,
-                ctx.to_eye,
-                ctx.ambient,
-                m.specular,
-                m.shininess,
-            )
+            shade::light_terms(n, &ctx.lights, ctx.ambient, m.specular, m.shininess)
         })
         .collect()
 }

@@ -106,11 +106,10 @@ impl RegionRenderer {
                 self.pass.xf[v] = transform_one(new.positions()[v], mvp, &planes, vp);
                 if gouraud {
                     let m = &new.materials()[scene.prepared().vertex_material[v] as usize];
-                    let (lights, to_eye) = (&self.pass.lights, self.pass.to_eye);
+                    let lights = &self.pass.lights;
                     self.vertex_light[v] = shade::light_terms(
                         new.normals()[v],
                         lights,
-                        to_eye,
                         scene.ambient,
                         m.specular,
                         m.shininess,
@@ -122,7 +121,9 @@ impl RegionRenderer {
         for &t in changed {
             let xf = &self.pass.xf;
             let corners = new.triangles()[t as usize];
-            self.pass.binned.replace(t, new.triangle_count(), |out| setup_one(t, corners, xf, &planes, vp, out));
+            self.pass.binned.replace(t, new.triangle_count(), |out| {
+                setup_one(t, corners, xf, &planes, vp, out)
+            });
             for id in self.pass.binned.ids_of(t) {
                 grow(self.pass.binned.get(id).bbox);
             }

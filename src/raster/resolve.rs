@@ -12,7 +12,7 @@ use super::clip::ClipPlanes;
 use super::edge::{self, EMPTY, TileSamples};
 use super::frame::{Frame, NO_TRIANGLE};
 use super::setup::{self, Viewport, XfVertex};
-use super::shade::ShadeContext;
+use super::shade::{ResolvedLight, ShadeContext};
 use super::{RenderSettings, Shading, camera_setup, vertex_lighting};
 use crate::scene::{Camera, Scene};
 
@@ -28,9 +28,8 @@ pub(crate) struct Pass {
     pub binned: Binned,
     pub offsets: Vec<[i64; 2]>,
     count_coverage: bool,
-    /// Resolved lights (direction towards the light, colour).
-    pub lights: Vec<(Vec3, Vec3)>,
-    pub to_eye: Vec3,
+    /// Lights resolved for the camera.
+    pub lights: Vec<ResolvedLight>,
     depth_range: (f32, f32, bool),
 }
 
@@ -73,8 +72,14 @@ impl Pass {
             binned,
             offsets: settings.samples.offsets(),
             count_coverage,
-            lights: scene.lights.iter().map(|l| l.resolve(camera)).collect(),
-            to_eye: camera.to_eye(),
+            lights: scene
+                .lights
+                .iter()
+                .map(|l| {
+                    let (dir, color) = l.resolve(camera);
+                    ResolvedLight::new(dir, color, camera.to_eye())
+                })
+                .collect(),
             depth_range,
         }
     }
@@ -87,7 +92,6 @@ impl Pass {
             setup: &self.binned,
             shading: self.settings.shading,
             lights: self.lights.clone(),
-            to_eye: self.to_eye,
             ambient: self.scene.ambient,
             vertex_light: Cow::Borrowed(&[]),
             depth_range: self.depth_range,
@@ -132,6 +136,26 @@ impl Pass {
         for y in y0..y1 {
             for x in x0..x1 {
                 let base = ((y - y0) * (x1 - x0) + (x - x0)) as usize * s;
+                if s == 1 {
+                    // One sample: no grouping; shade at the sample or show the background.
+                    let id = buf.ids[base];
+                    let o = self.offsets[0];
+                    let (color, tri) = match id {
+                        EMPTY => (bg, NO_TRIANGLE),
+                        _ => {
+                            let (sx, sy) = (
+                                x as f64 + o[0] as f64 / 256.0,
+                                y as f64 + o[1] as f64 / 256.0,
+                            );
+                            (ctx.shade(id, sx, sy), self.binned.get(id).tri)
+                        }
+                    };
+                    out.color.push(color);
+                    out.depth.push(buf.depth[base]);
+                    out.coverage.push(if id == EMPTY { 0.0 } else { 1.0 });
+                    out.triangle.push(tri);
+                    continue;
+                }
                 groups.clear();
                 let mut empty = 0usize;
                 let mut depth = f32::INFINITY;

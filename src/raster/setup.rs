@@ -153,7 +153,13 @@ pub(crate) fn setup_one(
     }
     const CORNERS: [Vec3; 3] = [Vec3::X, Vec3::Y, Vec3::Z];
     if a.outcode | b.outcode | c.outcode == 0 {
-        emit(index, [a.projected, b.projected, c.projected], None, vp, out);
+        emit(
+            index,
+            [a.projected, b.projected, c.projected],
+            None,
+            vp,
+            out,
+        );
         return;
     }
     let corners = [a, b, c].map(|v| v.clip);
@@ -165,12 +171,24 @@ pub(crate) fn setup_one(
     let Some(projected) = projected else { return };
     for k in 1..poly.len().saturating_sub(1) {
         let bary = [poly[0].bary, poly[k].bary, poly[k + 1].bary];
-        emit(index, [projected[0], projected[k], projected[k + 1]], Some(bary), vp, out);
+        emit(
+            index,
+            [projected[0], projected[k], projected[k + 1]],
+            Some(bary),
+            vp,
+            out,
+        );
     }
 }
 
 /// Orient and bound one projected triangle; `bary` are its corners' barycentrics when clipped.
-fn emit(index: u32, p: [Projected; 3], mut bary: Option<[Vec3; 3]>, vp: Viewport, out: &mut SetupOut) {
+fn emit(
+    index: u32,
+    p: [Projected; 3],
+    mut bary: Option<[Vec3; 3]>,
+    vp: Viewport,
+    out: &mut SetupOut,
+) {
     let mut v = p.map(|q| q.v);
     let mut z = p.map(|q| q.z);
     let mut inv_w = p.map(|q| q.inv_w);

@@ -32,10 +32,8 @@ pub(crate) struct ShadeContext<'a> {
     pub prepared: &'a PreparedMesh,
     pub setup: &'a Binned,
     pub shading: Shading,
-    /// (unit direction towards the light, colour), world space.
-    pub lights: Vec<(Vec3, Vec3)>,
-    /// Unit direction towards the (infinite) viewer.
-    pub to_eye: Vec3,
+    /// Lights resolved for this camera, world space.
+    pub lights: Vec<ResolvedLight>,
     pub ambient: f32,
     /// Per-vertex (diffuse light, specular) terms for `gouraud` (borrowed by region updates).
     pub vertex_light: std::borrow::Cow<'a, [(Vec3, Vec3)]>,
@@ -46,23 +44,50 @@ pub(crate) struct ShadeContext<'a> {
 /// Light terms at a normal: (k_a + Σ c·max(N·L,0), K_s ∘ Σ c·max(N·H,0)^n).
 pub(crate) fn light_terms(
     n: Vec3,
-    lights: &[(Vec3, Vec3)],
-    to_eye: Vec3,
+    lights: &[ResolvedLight],
     ambient: f32,
     ks: Vec3,
     shininess: f32,
 ) -> (Vec3, Vec3) {
     let mut diffuse = Vec3::splat(ambient);
     let mut spec = Vec3::ZERO;
-    for &(l, c) in lights {
-        let ndl = n.dot(l);
+    for light in lights {
+        let ndl = n.dot(light.l);
         if ndl > 0.0 {
-            diffuse += c * ndl;
-            let h = (l + to_eye).normalize_or_zero();
-            spec += c * n.dot(h).max(0.0).powf(shininess);
+            diffuse += light.color * ndl;
+            spec += light.color * highlight(n.dot(light.h).max(0.0), shininess);
         }
     }
     (diffuse, ks * spec)
+}
+
+/// x^n for the Blinn–Phong highlight; integer exponents (the common case: MTL `Ns`, the default
+/// 32) by repeated multiplication, which is several times cheaper than `powf`.
+fn highlight(x: f32, n: f32) -> f32 {
+    if n.fract() == 0.0 && (0.0..=4096.0).contains(&n) {
+        x.powi(n as i32)
+    } else {
+        x.powf(n)
+    }
+}
+
+/// A light resolved for one camera: direction towards it, colour, and the Blinn half vector
+/// (constant per frame for a directional light and an infinite viewer).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct ResolvedLight {
+    pub l: Vec3,
+    pub color: Vec3,
+    pub h: Vec3,
+}
+
+impl ResolvedLight {
+    pub fn new(l: Vec3, color: Vec3, to_eye: Vec3) -> ResolvedLight {
+        ResolvedLight {
+            l,
+            color,
+            h: (l + to_eye).normalize_or_zero(),
+        }
+    }
 }
 
 impl ShadeContext<'_> {
@@ -157,7 +182,6 @@ impl ShadeContext<'_> {
                 light_terms(
                     n,
                     &self.lights,
-                    self.to_eye,
                     self.ambient,
                     material.specular,
                     material.shininess,
