@@ -1,4 +1,11 @@
-//! The perceptual difference stack. Colour conversions live in `color.rs`; the metrics themselves
-//! arrive with the metric-stack issue.
+//! The perceptual difference stack: every metric takes two linear-RGB images of equal size
+//! ([`LinearImage`]), is prepared once per reference where it has per-image work, and returns
+//! named results with units. One metric per file, in the order of the maths:
+//! `color.rs` (encodings), `flip.rs` (ꟻLIP), `pool.rs` (pooling).
 
 pub mod color;
+pub mod flip;
+mod image;
+pub mod pool;
+
+pub use image::{ErrorMap, LinearImage};

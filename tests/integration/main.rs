@@ -6,6 +6,7 @@
 //! - `models`: `lodeval info` on every model of the shared collection against MANIFEST.md's counts
 //!   (skipped only when `../shared` is absent) and on the shipped `reference/models`.
 //! - `fuzz`: property-based mutation fuzzing of the OBJ, PLY, OFF and GLB paths.
+//! - `oracles`: metrics against reference implementations (FLIP: NVIDIA's; SSIM/PSNR: scikit-image).
 //! - `raster`: the CPU rasterizer (determinism over thread counts, watertightness, golden images,
 //!   the `render` CLI).
 
@@ -14,4 +15,5 @@ mod cli;
 mod common;
 mod fuzz;
 mod models;
+mod oracles;
 mod raster;

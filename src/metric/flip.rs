@@ -1,0 +1,453 @@
+//! ꟻLIP for low-dynamic-range images: a per-pixel perceptual difference in [0, 1] for images
+//! viewed alternately ("flipped") at a given number of pixels per degree.
+//!
+//! Based on: Pontus Andersson, Jim Nilsson, Tomas Akenine-Möller, Magnus Oskarsson, Kalle Åström,
+//! Mark D. Fairchild. FLIP: A Difference Evaluator for Alternating Images. HPG 2020 — §3 (colour
+//! pipeline: YCxCz, contrast-sensitivity filtering with the sum-of-Gaussians CSFs of Table 1 —
+//! a1 = (1, 1, 34.1), b1 = (0.0047, 0.0053, 0.04), a2 = (0, 0, 13.5), b2 = (1e-5, 1e-5, 0.025) —
+//! Hunt adjustment, HyAB distance, qc = 0.7, pc = 0.4, pt = 0.95), §4 (edge and point features
+//! from first and second derivatives of a Gaussian of width w = 0.082°, qf = 0.5) and eq. 11
+//! (error = ΔE_c^(1 − ΔE_f)). The published reference implementation (NVlabs/flip, v1.7) defines
+//! the details the paper leaves open, and this file follows those facts so that results agree
+//! with it (tests: `reference/oracles/flip/`): filters are separable (the blue–yellow sum of two
+//! Gaussians as two separable passes with √-weights, normalised to unit total), image borders are
+//! clamped, the spatial filter radius is ⌈3·√(max b / 2π²)·ppd⌉, the feature filter's Gaussian sums
+//! to 1 and the positive and negative lobes of its derivatives to ±1, arithmetic is `f32`.
+//!
+//! Prepare once, compare many (DESIGN.md): [`Flip::prepare`] does each image's filtering; the
+//! comparison is per pixel. Rows run in parallel; every pixel's arithmetic is independent of the
+//! schedule, and the mean is a fixed-order sum of per-row `f64` sums, so results do not depend on
+//! the thread count.
+
+use glam::Vec3;
+use rayon::prelude::*;
+
+use super::image::{ErrorMap, LinearImage, same_size};
+use crate::error::Result;
+
+/// π as the reference implementation writes it (`f32`).
+#[allow(clippy::excessive_precision)]
+const PI: f32 = 3.14159265358979;
+/// Colour-difference exponent qc.
+const QC: f32 = 0.7;
+/// Error-remapping knee pc.
+const PC: f32 = 0.4;
+/// Error-remapping knee value pt.
+const PT: f32 = 0.95;
+/// Feature-detector width w, degrees.
+const W: f32 = 0.082;
+/// Feature-difference exponent qf.
+const QF: f32 = 0.5;
+/// CSF sum-of-Gaussians parameters per channel (Y, Cx, Cz), paper Table 1.
+const A1: [f32; 3] = [1.0, 1.0, 34.1];
+const B1: [f32; 3] = [0.0047, 0.0053, 0.04];
+const A2: [f32; 3] = [0.0, 0.0, 13.5];
+const B2: [f32; 3] = [1.0e-5, 1.0e-5, 0.025];
+
+/// D65 reference white and its inverse, as the reference implementation gives them.
+/// (Digits exactly as the reference writes them: FLIP's error at nearly identical pixels is very
+/// sensitive to the last bit of every constant.)
+#[allow(clippy::excessive_precision)]
+const WHITE: Vec3 = Vec3::new(0.950428545, 1.000000000, 1.088900371);
+#[allow(clippy::excessive_precision)]
+const INV_WHITE: Vec3 = Vec3::new(1.052156925, 1.000000000, 0.918357670);
+
+/// Linear sRGB → CIE XYZ (D65).
+fn rgb_to_xyz(c: Vec3) -> Vec3 {
+    let m = [
+        [
+            10_135_552.0 / 24_577_794.0,
+            8_788_810.0 / 24_577_794.0,
+            4_435_075.0 / 24_577_794.0,
+        ],
+        [
+            2_613_072.0 / 12_288_897.0,
+            8_788_810.0 / 12_288_897.0,
+            887_015.0 / 12_288_897.0,
+        ],
+        [
+            1_425_312.0 / 73_733_382.0,
+            8_788_810.0 / 73_733_382.0,
+            70_074_185.0 / 73_733_382.0,
+        ],
+    ];
+    Vec3::new(
+        m[0][0] * c.x + m[0][1] * c.y + m[0][2] * c.z,
+        m[1][0] * c.x + m[1][1] * c.y + m[1][2] * c.z,
+        m[2][0] * c.x + m[2][1] * c.y + m[2][2] * c.z,
+    )
+}
+
+/// CIE XYZ → linear sRGB (D65).
+#[allow(clippy::excessive_precision)]
+fn xyz_to_rgb(c: Vec3) -> Vec3 {
+    Vec3::new(
+        3.241003275 * c.x + -1.537398934 * c.y + -0.498615861 * c.z,
+        -0.969224334 * c.x + 1.875930071 * c.y + 0.041554224 * c.z,
+        0.055639423 * c.x + -0.204011202 * c.y + 1.057148933 * c.z,
+    )
+}
+
+/// XYZ → YCxCz (the linearised CIELAB of Zhang & Wandell's S-CIELAB).
+fn xyz_to_ycxcz(c: Vec3) -> Vec3 {
+    let c = c * INV_WHITE;
+    Vec3::new(116.0 * c.y - 16.0, 500.0 * (c.x - c.y), 200.0 * (c.y - c.z))
+}
+
+fn ycxcz_to_xyz(c: Vec3) -> Vec3 {
+    let y = (c.x + 16.0) / 116.0;
+    Vec3::new(y + c.y / 500.0, y, y - c.z / 200.0) * WHITE
+}
+
+/// XYZ → CIELAB (D65).
+fn xyz_to_lab(c: Vec3) -> Vec3 {
+    let delta = 6.0f32 / 29.0;
+    let delta_sq = delta * delta;
+    let delta_cube = delta * delta_sq;
+    let factor = 1.0 / (3.0 * delta_sq);
+    let term = 4.0f32 / 29.0;
+    let c = c * INV_WHITE;
+    let f = |v: f32| {
+        if v > delta_cube {
+            v.powf(1.0 / 3.0)
+        } else {
+            factor * v + term
+        }
+    };
+    let (x, y, z) = (f(c.x), f(c.y), f(c.z));
+    Vec3::new(116.0 * y - 16.0, 500.0 * (x - y), 200.0 * (y - z))
+}
+
+/// Hunt-adjusted CIELAB: chroma scaled by 0.01·L (paper §3.2).
+fn hunt(lab: Vec3) -> Vec3 {
+    Vec3::new(lab.x, 0.01 * lab.x * lab.y, 0.01 * lab.x * lab.z)
+}
+
+/// HyAB distance: |ΔL| + ‖Δ(a, b)‖ (Abasi et al. 2020; paper §3.2).
+fn hyab(a: Vec3, b: Vec3) -> f32 {
+    (a.x - b.x).abs() + ((a.y - b.y) * (a.y - b.y) + (a.z - b.z) * (a.z - b.z)).sqrt()
+}
+
+/// The largest colour difference, green vs blue, raised to qc (paper §3.2).
+fn max_distance() -> f32 {
+    let green = hunt(xyz_to_lab(rgb_to_xyz(Vec3::Y)));
+    let blue = hunt(xyz_to_lab(rgb_to_xyz(Vec3::Z)));
+    hyab(green, blue).powf(QC)
+}
+
+/// 1D Gaussian a·√(π/b)·exp(−π²x²/b) (paper eq. 2) and its square-root-weighted variant used to
+/// separate a sum of two Gaussians into two separable passes.
+fn gaussian(x2: f32, a: f32, b: f32) -> f32 {
+    a * (PI / b).sqrt() * (-(PI * PI) * x2 / b).exp()
+}
+fn gaussian_sqrt(x2: f32, a: f32, b: f32) -> f32 {
+    (a * (PI / b).sqrt()).sqrt() * (-(PI * PI) * x2 / b).exp()
+}
+
+/// The separable spatial filters: per tap (Y, Cx) and (Cz first Gaussian, Cz second Gaussian).
+fn spatial_filters(ppd: f32) -> Vec<([f32; 2], [f32; 2])> {
+    let max_b = B1.iter().chain(&B2).fold(0.0f32, |m, &b| m.max(b));
+    let radius = (3.0 * (max_b / (2.0 * PI * PI)).sqrt() * ppd).ceil() as i32;
+    let dx = 1.0 / ppd;
+    let mut taps: Vec<([f32; 2], [f32; 2])> = (-radius..=radius)
+        .map(|i| {
+            let x = i as f32 * dx;
+            let x2 = x * x;
+            (
+                [gaussian(x2, A1[0], B1[0]), gaussian(x2, A1[1], B1[1])],
+                [
+                    gaussian_sqrt(x2, A1[2], B1[2]),
+                    gaussian_sqrt(x2, A2[2], B2[2]),
+                ],
+            )
+        })
+        .collect();
+    let mut sum_ycx = [0.0f32; 2];
+    let mut sum_cz = [0.0f32; 2];
+    for (ycx, cz) in &taps {
+        sum_ycx[0] += ycx[0];
+        sum_ycx[1] += ycx[1];
+        sum_cz[0] += cz[0];
+        sum_cz[1] += cz[1];
+    }
+    let norm_cz = 1.0 / (sum_cz[0] * sum_cz[0] + sum_cz[1] * sum_cz[1]).sqrt();
+    for (ycx, cz) in &mut taps {
+        ycx[0] *= 1.0 / sum_ycx[0];
+        ycx[1] *= 1.0 / sum_ycx[1];
+        cz[0] *= norm_cz;
+        cz[1] *= norm_cz;
+    }
+    taps
+}
+
+/// The separable feature filter: per tap (Gaussian, 1st derivative, 2nd derivative) (paper §4).
+fn feature_filter(ppd: f32) -> Vec<[f32; 3]> {
+    let sd = 0.5 * W * ppd;
+    let radius = (3.0 * sd).ceil() as i32;
+    let mut taps = Vec::with_capacity(2 * radius as usize + 1);
+    let (mut g_sum, mut dg_pos, mut dg_neg, mut ddg_pos, mut ddg_neg) =
+        (0.0f32, 0.0f32, 0.0f32, 0.0f32, 0.0f32);
+    for i in -radius..=radius {
+        let x = i as f32;
+        let g = (-(x * x) / (2.0 * sd * sd)).exp();
+        g_sum += g;
+        let dg = -x * g;
+        if dg > 0.0 {
+            dg_pos += dg
+        } else {
+            dg_neg -= dg
+        }
+        let ddg = (x * x / (sd * sd) - 1.0) * g;
+        if ddg > 0.0 {
+            ddg_pos += ddg
+        } else {
+            ddg_neg -= ddg
+        }
+        taps.push([g, dg, ddg]);
+    }
+    for t in &mut taps {
+        t[0] /= g_sum;
+        t[1] /= if t[1] > 0.0 { dg_pos } else { dg_neg };
+        t[2] /= if t[2] > 0.0 { ddg_pos } else { ddg_neg };
+    }
+    taps
+}
+
+/// Horizontal then vertical pass of a separable filter with clamped borders. `pass_x` maps a row
+/// of source values to filtered ones (`K` channels); `pass_y` likewise per column, fed the
+/// horizontal results. Both run over rows in parallel.
+fn separable<S: Sync, I: Send + Sync + Copy + Default, O: Send>(
+    width: usize,
+    height: usize,
+    src: &[S],
+    pass_x: impl Fn(&[S], usize) -> I + Sync,
+    pass_y: impl Fn(&[I], usize, usize) -> O + Sync,
+) -> Vec<O> {
+    let mut mid = vec![I::default(); width * height];
+    mid.par_chunks_mut(width).enumerate().for_each(|(y, row)| {
+        let src_row = &src[y * width..(y + 1) * width];
+        for (x, out) in row.iter_mut().enumerate() {
+            *out = pass_x(src_row, x);
+        }
+    });
+    (0..height)
+        .into_par_iter()
+        .flat_map_iter(|y| {
+            let mid = &mid;
+            let pass_y = &pass_y;
+            (0..width).map(move |x| pass_y(mid, x, y))
+        })
+        .collect()
+}
+
+/// Clamp-to-edge index.
+#[inline]
+fn clamp_index(i: isize, n: usize) -> usize {
+    i.clamp(0, n as isize - 1) as usize
+}
+
+/// FLIP at one viewing condition.
+#[derive(Debug, Clone)]
+pub struct Flip {
+    ppd: f32,
+    spatial: Vec<([f32; 2], [f32; 2])>,
+    features: Vec<[f32; 3]>,
+    cmax: f32,
+}
+
+/// One image after FLIP's per-image work.
+#[derive(Debug, Clone)]
+pub struct FlipPrepared {
+    width: usize,
+    height: usize,
+    /// Spatially filtered, Hunt-adjusted CIELAB.
+    lab: Vec<Vec3>,
+    /// Edge and point feature magnitudes.
+    features: Vec<[f32; 2]>,
+}
+
+/// The result of a FLIP comparison.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FlipScore {
+    /// Mean of the error map (f64 sum of the f32 map in row order), in [0, 1].
+    pub mean: f64,
+    /// The per-pixel error in [0, 1].
+    pub map: ErrorMap,
+}
+
+impl Flip {
+    /// FLIP for `ppd` pixels per degree of visual angle (DESIGN.md default: 67.02).
+    pub fn new(ppd: f32) -> Flip {
+        Flip {
+            ppd,
+            spatial: spatial_filters(ppd),
+            features: feature_filter(ppd),
+            cmax: max_distance(),
+        }
+    }
+
+    /// Pixels per degree this evaluator was built for.
+    pub fn ppd(&self) -> f32 {
+        self.ppd
+    }
+
+    /// Filter one image (linear RGB) into what the comparison needs.
+    pub fn prepare(&self, image: &LinearImage) -> FlipPrepared {
+        let (w, h) = (image.width(), image.height());
+        let ycxcz: Vec<Vec3> = image
+            .pixels()
+            .par_iter()
+            .map(|&c| xyz_to_ycxcz(rgb_to_xyz(c)))
+            .collect();
+        let r = (self.spatial.len() / 2) as isize;
+        // Colour: CSF filtering in YCxCz, back to linear RGB (clamped), CIELAB, Hunt.
+        let lab = separable(
+            w,
+            h,
+            &ycxcz,
+            |row: &[Vec3], x| {
+                let mut acc = [0.0f32; 4];
+                for (k, (ycx, cz)) in self.spatial.iter().enumerate() {
+                    let c = row[clamp_index(x as isize + k as isize - r, w)];
+                    acc[0] += ycx[0] * c.x;
+                    acc[1] += ycx[1] * c.y;
+                    acc[2] += cz[0] * c.z;
+                    acc[3] += cz[1] * c.z;
+                }
+                acc
+            },
+            |mid: &[[f32; 4]], x, y| {
+                let mut acc = [0.0f32; 4];
+                for (k, (ycx, cz)) in self.spatial.iter().enumerate() {
+                    let m = mid[clamp_index(y as isize + k as isize - r, h) * w + x];
+                    acc[0] += ycx[0] * m[0];
+                    acc[1] += ycx[1] * m[1];
+                    acc[2] += cz[0] * m[2];
+                    acc[3] += cz[1] * m[3];
+                }
+                let filtered = Vec3::new(acc[0], acc[1], acc[2] + acc[3]);
+                let rgb = xyz_to_rgb(ycxcz_to_xyz(filtered)).clamp(Vec3::ZERO, Vec3::ONE);
+                hunt(xyz_to_lab(rgb_to_xyz(rgb)))
+            },
+        );
+        // Features: edges and points on the normalised achromatic channel.
+        let gray: Vec<f32> = ycxcz
+            .iter()
+            .map(|c| c.x * (1.0 / 116.0) + 16.0 / 116.0)
+            .collect();
+        let r = (self.features.len() / 2) as isize;
+        let features = separable(
+            w,
+            h,
+            &gray,
+            |row: &[f32], x| {
+                let mut acc = [0.0f32; 3]; // d/dx, d²/dx², Gaussian
+                for (k, f) in self.features.iter().enumerate() {
+                    let v = row[clamp_index(x as isize + k as isize - r, w)];
+                    acc[0] += f[1] * v;
+                    acc[1] += f[2] * v;
+                    acc[2] += f[0] * v;
+                }
+                acc
+            },
+            |mid: &[[f32; 3]], x, y| {
+                let (mut dx, mut ddx, mut dy, mut ddy) = (0.0f32, 0.0f32, 0.0f32, 0.0f32);
+                for (k, f) in self.features.iter().enumerate() {
+                    let m = mid[clamp_index(y as isize + k as isize - r, h) * w + x];
+                    dx += f[0] * m[0];
+                    ddx += f[0] * m[1];
+                    dy += f[1] * m[2];
+                    ddy += f[2] * m[2];
+                }
+                [(dx * dx + dy * dy).sqrt(), (ddx * ddx + ddy * ddy).sqrt()]
+            },
+        );
+        FlipPrepared {
+            width: w,
+            height: h,
+            lab,
+            features,
+        }
+    }
+
+    /// Compare two prepared images.
+    pub fn compare_prepared(
+        &self,
+        reference: &FlipPrepared,
+        test: &FlipPrepared,
+    ) -> Result<FlipScore> {
+        if (reference.width, reference.height) != (test.width, test.height) {
+            return Err(crate::error::Error::Usage(format!(
+                "the images differ in size ({}x{} vs {}x{}); render or crop them to the same size",
+                reference.width, reference.height, test.width, test.height
+            )));
+        }
+        let cmax = self.cmax;
+        let pccmax = PC * cmax;
+        let inv_sqrt2 = 1.0 / 2f32.sqrt();
+        let values: Vec<f32> = (0..reference.lab.len())
+            .into_par_iter()
+            .with_min_len(4096)
+            .map(|i| {
+                // Colour difference, remapped to [0, 1] with the knee at pc·cmax (paper §3.2).
+                let mut dc = hyab(reference.lab[i], test.lab[i]).powf(QC);
+                dc = if dc < pccmax {
+                    dc * (PT / pccmax)
+                } else {
+                    PT + ((dc - pccmax) / (cmax - pccmax)) * (1.0 - PT)
+                };
+                // Feature difference (paper §4).
+                let [er, pr] = reference.features[i];
+                let [et, pt] = test.features[i];
+                let df = (inv_sqrt2 * (er - et).abs().max((pr - pt).abs())).powf(QF);
+                dc.powf(1.0 - df)
+            })
+            .collect();
+        let mean = super::pool::mean(&values, reference.width);
+        Ok(FlipScore {
+            mean,
+            map: ErrorMap {
+                width: reference.width,
+                height: reference.height,
+                values,
+            },
+        })
+    }
+
+    /// Compare two images (prepares both).
+    pub fn compare(&self, reference: &LinearImage, test: &LinearImage) -> Result<FlipScore> {
+        same_size(reference, test)?;
+        self.compare_prepared(&self.prepare(reference), &self.prepare(test))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn identical_images_score_zero_and_filters_are_normalised() {
+        let img = LinearImage::new(
+            7,
+            5,
+            (0..35).map(|i| Vec3::splat(i as f32 / 35.0)).collect(),
+        )
+        .unwrap();
+        let f = Flip::new(67.02);
+        let s = f.compare(&img, &img).unwrap();
+        assert_eq!(s.mean, 0.0);
+        let sum_y: f32 = f.spatial.iter().map(|t| t.0[0]).sum();
+        assert!((sum_y - 1.0).abs() < 1e-5);
+        let g: f32 = f.features.iter().map(|t| t[0]).sum();
+        assert!((g - 1.0).abs() < 1e-5);
+    }
+
+    #[test]
+    fn black_versus_white_is_near_maximal() {
+        // The largest achromatic difference: ΔE_c is remapped above pt.
+        let black = LinearImage::new(4, 4, vec![Vec3::ZERO; 16]).unwrap();
+        let white = LinearImage::new(4, 4, vec![Vec3::ONE; 16]).unwrap();
+        let s = Flip::new(67.02).compare(&black, &white).unwrap();
+        assert!(s.mean > 0.9, "{}", s.mean);
+    }
+}

@@ -1,0 +1,110 @@
+//! `LinearImage`: the input every metric takes — linear RGB `f32`, row-major, top row first — and
+//! `ErrorMap`, a per-pixel score. Metrics work on any two images of equal size, rendered or loaded.
+
+use glam::Vec3;
+
+use crate::error::{Error, Result};
+use crate::metric::color::srgb_to_linear;
+
+/// A linear-light RGB image.
+///
+/// # Guarantees
+/// - `width, height >= 1` and `pixels().len() == width * height`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct LinearImage {
+    width: usize,
+    height: usize,
+    pixels: Vec<Vec3>,
+}
+
+impl LinearImage {
+    /// An image from linear RGB pixels; `None` if the sizes disagree or either is zero.
+    pub fn new(width: usize, height: usize, pixels: Vec<Vec3>) -> Option<LinearImage> {
+        (width >= 1 && height >= 1 && pixels.len() == width * height).then_some(LinearImage {
+            width,
+            height,
+            pixels,
+        })
+    }
+
+    /// Decode 8-bit sRGB RGB bytes (row-major) to linear light.
+    pub fn from_srgb8(width: usize, height: usize, rgb: &[u8]) -> Option<LinearImage> {
+        let lut: Vec<f32> = (0..256).map(|i| srgb_to_linear(i as f32 / 255.0)).collect();
+        let pixels = rgb
+            .chunks_exact(3)
+            .map(|c| Vec3::new(lut[c[0] as usize], lut[c[1] as usize], lut[c[2] as usize]))
+            .collect();
+        LinearImage::new(width, height, pixels)
+    }
+
+    /// Load a PNG/JPEG/EXR file: 8-bit files are sRGB-decoded, float files taken as linear.
+    pub fn load(path: &std::path::Path) -> Result<LinearImage> {
+        let img = image::open(path).map_err(|e| {
+            Error::input(
+                path,
+                format!("cannot read the image: {e}"),
+                "give a PNG, JPEG or EXR file",
+            )
+        })?;
+        let (w, h) = (img.width() as usize, img.height() as usize);
+        let out = match img {
+            image::DynamicImage::ImageRgb32F(_) | image::DynamicImage::ImageRgba32F(_) => {
+                let f = img.into_rgb32f();
+                LinearImage::new(w, h, f.pixels().map(|p| Vec3::from(p.0)).collect())
+            }
+            other => LinearImage::from_srgb8(w, h, other.into_rgb8().as_raw()),
+        };
+        out.ok_or_else(|| {
+            Error::input(
+                path,
+                format!("the image has zero size ({w}x{h})"),
+                "give a non-empty image",
+            )
+        })
+    }
+
+    /// Width in pixels.
+    pub fn width(&self) -> usize {
+        self.width
+    }
+    /// Height in pixels.
+    pub fn height(&self) -> usize {
+        self.height
+    }
+    /// Linear RGB pixels.
+    pub fn pixels(&self) -> &[Vec3] {
+        &self.pixels
+    }
+}
+
+impl From<&crate::raster::Frame> for LinearImage {
+    fn from(f: &crate::raster::Frame) -> LinearImage {
+        LinearImage {
+            width: f.width() as usize,
+            height: f.height() as usize,
+            pixels: f.color().to_vec(),
+        }
+    }
+}
+
+/// A per-pixel error, row-major, top row first.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ErrorMap {
+    /// Width in pixels.
+    pub width: usize,
+    /// Height in pixels.
+    pub height: usize,
+    /// One value per pixel, in the metric's units.
+    pub values: Vec<f32>,
+}
+
+/// Check that two images can be compared.
+pub(crate) fn same_size(a: &LinearImage, b: &LinearImage) -> Result<()> {
+    if a.width != b.width || a.height != b.height {
+        return Err(Error::Usage(format!(
+            "the images differ in size ({}x{} vs {}x{}); render or crop them to the same size",
+            a.width, a.height, b.width, b.height
+        )));
+    }
+    Ok(())
+}

@@ -1,0 +1,74 @@
+//! Pooling per-pixel scores into numbers: mean, percentiles, maximum, Minkowski sums, histograms.
+//!
+//! Determinism: sums run row by row in `f64`, rows combined in row order, so the result never
+//! depends on how work was split. Percentiles sort a copy (total order on `f32`), so ties and
+//! thread count cannot change them.
+
+use rayon::prelude::*;
+
+/// Mean of `values` (rows of `width`), summed in `f64` per row, rows added in order.
+pub fn mean(values: &[f32], width: usize) -> f64 {
+    if values.is_empty() {
+        return 0.0;
+    }
+    let rows: Vec<f64> = values
+        .par_chunks(width.max(1))
+        .map(|r| r.iter().map(|&v| v as f64).sum())
+        .collect();
+    rows.iter().sum::<f64>() / values.len() as f64
+}
+
+/// The `p`-th percentile (0..=100) by linear interpolation between closest ranks (NumPy's default).
+pub fn percentile(values: &[f32], p: f64) -> f64 {
+    if values.is_empty() {
+        return 0.0;
+    }
+    let mut sorted = values.to_vec();
+    sorted.par_sort_unstable_by(|a, b| a.total_cmp(b));
+    let rank = p.clamp(0.0, 100.0) / 100.0 * (sorted.len() - 1) as f64;
+    let (lo, hi) = (rank.floor() as usize, rank.ceil() as usize);
+    let t = rank - lo as f64;
+    sorted[lo] as f64 * (1.0 - t) + sorted[hi] as f64 * t
+}
+
+/// Largest value.
+pub fn max(values: &[f32]) -> f64 {
+    values.iter().fold(f32::NEG_INFINITY, |m, &v| m.max(v)) as f64
+}
+
+/// Minkowski pooling (mean of |v|^β)^(1/β).
+pub fn minkowski(values: &[f32], width: usize, beta: f64) -> f64 {
+    let powered: Vec<f32> = values
+        .iter()
+        .map(|&v| (v.abs() as f64).powf(beta) as f32)
+        .collect();
+    mean(&powered, width).powf(1.0 / beta)
+}
+
+/// Histogram of values in [0, 1] with `bins` equal bins (values outside are clamped into the
+/// end bins).
+pub fn histogram(values: &[f32], bins: usize) -> Vec<u64> {
+    let mut h = vec![0u64; bins.max(1)];
+    let n = h.len();
+    for &v in values {
+        let b = ((v.clamp(0.0, 1.0) * n as f32) as usize).min(n - 1);
+        h[b] += 1;
+    }
+    h
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn percentiles_interpolate_like_numpy() {
+        // numpy.percentile([1, 2, 3, 4], 50) = 2.5 and 95 → 3.85.
+        let v = [4.0, 1.0, 3.0, 2.0];
+        assert_eq!(percentile(&v, 50.0), 2.5);
+        assert!((percentile(&v, 95.0) - 3.85).abs() < 1e-12);
+        assert_eq!(max(&v), 4.0);
+        assert_eq!(mean(&v, 2), 2.5);
+        assert_eq!(histogram(&[0.0, 0.5, 1.0], 2), vec![1, 2]);
+    }
+}
