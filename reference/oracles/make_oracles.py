@@ -128,15 +128,18 @@ def main():
         })
         # SSIM/PSNR on the same pairs where they are defined (7x7 minimum side for the 11-tap
         # Gaussian window is not required by skimage's gaussian mode, but sides >= 7 are).
+        # SSIM on Rec. 709 luma of the sRGB-encoded values (lodeval's default), needs sides >= 11
+        # for the cropped mean; PSNR on Rec. 709 luminance of linear values (lodeval's MSE).
+        r64, t64 = ref.astype(np.float64), test.astype(np.float64)
+        luma = lambda a: 0.2126 * a[..., 0] + 0.7152 * a[..., 1] + 0.0722 * a[..., 2]
+        lin = lambda a: np.where(a <= 0.04045, a / 12.92, ((a + 0.055) / 1.055) ** 2.4)
+        entry = {"name": name}
         if min(ref.shape[:2]) >= 11:
-            gray = lambda a: (0.2126 * a[..., 0] + 0.7152 * a[..., 1] + 0.0722 * a[..., 2]).astype(np.float64)
-            values["ssim"].append({
-                "name": name,
-                "ssim_luma_srgb": float(structural_similarity(gray(ref), gray(test), gaussian_weights=True, sigma=1.5,
-                                                              use_sample_covariance=False, data_range=1.0)),
-                "psnr_luma_srgb": float(peak_signal_noise_ratio(gray(ref), gray(test), data_range=1.0))
-                if not np.array_equal(ref, test) else None,
-            })
+            entry["ssim_luma_srgb"] = float(structural_similarity(luma(r64), luma(t64), gaussian_weights=True, sigma=1.5,
+                                                                  use_sample_covariance=False, data_range=1.0))
+        if not np.array_equal(ref, test):
+            entry["psnr_linear_luminance"] = float(peak_signal_noise_ratio(luma(lin(r64)), luma(lin(t64)), data_range=1.0))
+        values["ssim"].append(entry)
         print(f"{name}: FLIP mean {values['flip'][-1]['mean_f64']:.6f}")
     with open(os.path.join(OUT, "values.json"), "w") as f:
         json.dump(values, f, indent=1)

@@ -21,6 +21,12 @@ pub fn linear_to_srgb(c: f32) -> f32 {
     }
 }
 
+/// Rec. 709 luminance of linear RGB (DESIGN.md: the luminance lodeval uses unless a metric's
+/// definition says otherwise).
+pub fn luminance(c: glam::Vec3) -> f32 {
+    0.2126 * c.x + 0.7152 * c.y + 0.0722 * c.z
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

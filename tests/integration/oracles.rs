@@ -60,3 +60,40 @@ fn flip_matches_nvidias_reference_implementation() {
         );
     }
 }
+
+#[test]
+fn ssim_and_psnr_match_scikit_image() {
+    // Tolerance from the issue: 1e-5 (SSIM absolute; PSNR absolute in dB).
+    use lodeval::metric::{mse, ssim};
+    let v = values();
+    let flip_pairs = v["flip"].as_array().unwrap();
+    let mut checked = (0, 0);
+    for entry in v["ssim"].as_array().unwrap() {
+        let name = entry["name"].as_str().unwrap();
+        let p = flip_pairs
+            .iter()
+            .find(|p| p["name"] == entry["name"])
+            .unwrap();
+        let load = |k: &str| LinearImage::load(&root().join(p[k].as_str().unwrap())).unwrap();
+        let (reference, test) = (load("reference"), load("test"));
+        if let Some(expected) = entry["ssim_luma_srgb"].as_f64() {
+            let (ours, _) = ssim::ssim(&reference, &test, ssim::SsimInput::SrgbLuma).unwrap();
+            eprintln!("{name}: SSIM {ours:.8} vs {expected:.8}");
+            assert!(
+                (ours - expected).abs() <= 1e-5,
+                "{name}: SSIM {ours} vs {expected}"
+            );
+            checked.0 += 1;
+        }
+        if let Some(expected) = entry["psnr_linear_luminance"].as_f64() {
+            let ours = mse::mse(&reference, &test).unwrap().psnr_db;
+            eprintln!("{name}: PSNR {ours:.6} vs {expected:.6}");
+            assert!(
+                (ours - expected).abs() <= 1e-5,
+                "{name}: PSNR {ours} vs {expected}"
+            );
+            checked.1 += 1;
+        }
+    }
+    assert!(checked.0 >= 8 && checked.1 >= 10, "{checked:?}");
+}

@@ -1,0 +1,93 @@
+//! Mean squared error, RMSE and PSNR on luminance, and Lindstrom–Turk's multi-view d_MS.
+//!
+//! Based on: Peter Lindstrom, Greg Turk. Image-Driven Simplification. ACM TOG 2000, eq. 1:
+//! d_MS(Y⁰, Y¹) = 1/(l·m·n) Σ_h Σ_i Σ_j (y⁰_hij − y¹_hij)², the mean squared luminance difference
+//! over l views of m × n pixels.
+//!
+//! Decision: "luminance" is Rec. 709 Y of linear RGB (DESIGN.md, "Colour"), so MSE is in linear
+//! luminance units and PSNR uses a peak of 1 (display white). Identical images have MSE 0 and PSNR
+//! +∞ (reported as `f64::INFINITY`).
+
+use rayon::prelude::*;
+
+use super::color::luminance;
+use super::image::{LinearImage, same_size};
+use crate::error::Result;
+
+/// MSE-family scores of one image pair.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct MseScore {
+    /// Mean squared luminance difference (linear luminance², 0 = identical).
+    pub mse: f64,
+    /// Its square root (linear luminance).
+    pub rmse: f64,
+    /// 10·log10(1 / MSE) in dB; +∞ for identical images.
+    pub psnr_db: f64,
+}
+
+/// Sum of squared luminance differences, rows in parallel, combined in row order.
+fn sum_squared(a: &LinearImage, b: &LinearImage) -> f64 {
+    let w = a.width();
+    let rows: Vec<f64> = a
+        .pixels()
+        .par_chunks(w)
+        .zip(b.pixels().par_chunks(w))
+        .map(|(ra, rb)| {
+            ra.iter()
+                .zip(rb)
+                .map(|(&p, &q)| {
+                    let d = luminance(p) as f64 - luminance(q) as f64;
+                    d * d
+                })
+                .sum()
+        })
+        .collect();
+    rows.iter().sum()
+}
+
+/// MSE, RMSE and PSNR of two images of equal size.
+pub fn mse(reference: &LinearImage, test: &LinearImage) -> Result<MseScore> {
+    same_size(reference, test)?;
+    let mse = sum_squared(reference, test) / reference.pixels().len() as f64;
+    let psnr_db = if mse == 0.0 {
+        f64::INFINITY
+    } else {
+        10.0 * (1.0 / mse).log10()
+    };
+    Ok(MseScore {
+        mse,
+        rmse: mse.sqrt(),
+        psnr_db,
+    })
+}
+
+/// Lindstrom–Turk's d_MS over a set of views (eq. 1): the mean squared luminance difference over
+/// all pixels of all views. Every pair must have equal sizes; views may differ in size from each other.
+pub fn d_ms(pairs: &[(&LinearImage, &LinearImage)]) -> Result<f64> {
+    let mut sum = 0.0;
+    let mut count = 0usize;
+    for (a, b) in pairs {
+        same_size(a, b)?;
+        sum += sum_squared(a, b);
+        count += a.pixels().len();
+    }
+    Ok(if count == 0 { 0.0 } else { sum / count as f64 })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use glam::Vec3;
+
+    #[test]
+    fn known_values() {
+        // Luminance 0 vs 0.5 everywhere: MSE 0.25, PSNR = 10·log10(4) ≈ 6.0206 dB.
+        let a = LinearImage::new(2, 2, vec![Vec3::ZERO; 4]).unwrap();
+        let b = LinearImage::new(2, 2, vec![Vec3::splat(0.5); 4]).unwrap();
+        let s = mse(&a, &b).unwrap();
+        assert!((s.mse - 0.25).abs() < 1e-7 && (s.psnr_db - 6.020_599_9).abs() < 1e-5);
+        assert_eq!(mse(&a, &a).unwrap().psnr_db, f64::INFINITY);
+        // d_MS over two views weights pixels, not views: (4·0.25 + 4·0) / 8.
+        assert!((d_ms(&[(&a, &b), (&a, &a)]).unwrap() - 0.125).abs() < 1e-7);
+    }
+}
