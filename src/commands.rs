@@ -276,3 +276,229 @@ pub fn export_scene(dir: &Path, scene: &Scene, cameras: &[Camera]) -> Result<()>
     let json = serde_json::to_string_pretty(&views).map_err(|e| Error::Internal(e.to_string()))?;
     crate::io::write_atomic(&dir.join("views.json"), json.as_bytes())
 }
+
+/// The metrics `lodeval diff` computes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum DiffMetric {
+    /// ꟻLIP mean error in [0, 1].
+    Flip,
+    /// SSIM (sRGB luma) in [−1, 1].
+    Ssim,
+    /// MS-SSIM (sRGB luma) in [0, 1].
+    Msssim,
+    /// PSNR of linear luminance, dB.
+    Psnr,
+    /// MSE of linear luminance.
+    Mse,
+}
+
+impl DiffMetric {
+    /// Every metric `diff` can compute, in output order.
+    pub const ALL: [DiffMetric; 5] = [
+        DiffMetric::Flip,
+        DiffMetric::Ssim,
+        DiffMetric::Msssim,
+        DiffMetric::Psnr,
+        DiffMetric::Mse,
+    ];
+}
+
+/// One metric's result for `lodeval diff`.
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct DiffResult {
+    /// Metric name.
+    pub metric: DiffMetric,
+    /// The pooled value (see [`DiffMetric`] for units); `null` in JSON for an infinite PSNR.
+    pub value: Option<f64>,
+    /// Pixels per degree used.
+    pub ppd: f64,
+    /// Image width.
+    pub width: usize,
+    /// Image height.
+    pub height: usize,
+    /// FLIP only: percentiles p25, p50, p75, p95, p99 and the maximum of the error map.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub percentiles: Option<std::collections::BTreeMap<String, f64>>,
+    /// FLIP only: histogram of the error map, 20 bins over [0, 1].
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub histogram: Option<Vec<u64>>,
+    /// The heat map written, if any.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub map: Option<PathBuf>,
+    /// Why the value is missing, when a metric of `--metric all` does not apply to these images.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub note: Option<String>,
+}
+
+/// Compare two image files with the given metrics; writes magma heat maps if `map` is given
+/// (`map` itself for one metric with a map, `STEM-METRIC.png` beside it for several). With
+/// `lenient`, a metric that does not apply to images of this size (SSIM below 11×11, MS-SSIM
+/// below 176×176) is reported without a value and with a note instead of failing the command.
+pub fn diff(
+    reference: &Path,
+    test: &Path,
+    metrics: &[DiffMetric],
+    viewing: &crate::scene::Viewing,
+    map: Option<&Path>,
+    lenient: bool,
+) -> Result<Vec<DiffResult>> {
+    use crate::metric::{LinearImage, colormap, flip::Flip, mse, pool, ssim};
+    let (a, b) = (LinearImage::load(reference)?, LinearImage::load(test)?);
+    if (a.width(), a.height()) != (b.width(), b.height()) {
+        return Err(Error::input(
+            test,
+            format!(
+                "is {}x{} but the reference {} is {}x{}",
+                b.width(),
+                b.height(),
+                reference.display(),
+                a.width(),
+                a.height()
+            ),
+            "compare images of the same size",
+        ));
+    }
+    let ppd = viewing.ppd();
+    let (w, h) = (a.width(), a.height());
+    let with_maps = metrics
+        .iter()
+        .filter(|m| matches!(m, DiffMetric::Flip | DiffMetric::Ssim))
+        .count();
+    let map_path = |metric: DiffMetric| -> Option<PathBuf> {
+        let p = map?;
+        if with_maps <= 1 {
+            return Some(p.to_path_buf());
+        }
+        let stem = p.file_stem()?.to_string_lossy();
+        let name = serde_json::to_value(metric).ok()?.as_str()?.to_string();
+        Some(p.with_file_name(format!("{stem}-{name}.png")))
+    };
+    let mut out = Vec::new();
+    for &metric in metrics {
+        let mut r = DiffResult {
+            metric,
+            value: None,
+            ppd,
+            width: w,
+            height: h,
+            percentiles: None,
+            histogram: None,
+            map: None,
+            note: None,
+        };
+        let mut compute = || -> Result<()> {
+            match metric {
+                DiffMetric::Flip => {
+                    let s = Flip::new(ppd as f32).compare(&a, &b)?;
+                    let v = &s.map.values;
+                    let mut p = std::collections::BTreeMap::new();
+                    for q in [25.0, 50.0, 75.0, 95.0, 99.0] {
+                        p.insert(format!("p{q}"), pool::percentile(v, q));
+                    }
+                    p.insert("max".into(), pool::max(v));
+                    r.value = Some(s.mean);
+                    r.percentiles = Some(p);
+                    r.histogram = Some(pool::histogram(v, 20));
+                    if let Some(path) = map_path(metric) {
+                        crate::io::write_image(
+                            &path,
+                            &image::DynamicImage::ImageRgb8(colormap::heat_map(
+                                v,
+                                w,
+                                h,
+                                (h / 32).max(4),
+                            )),
+                        )?;
+                        r.map = Some(path);
+                    }
+                }
+                DiffMetric::Ssim => {
+                    let (mean, smap) = ssim::ssim(&a, &b, ssim::SsimInput::SrgbLuma)?;
+                    r.value = Some(mean);
+                    if let Some(path) = map_path(metric) {
+                        let err: Vec<f32> =
+                            smap.iter().map(|s| (1.0 - s).clamp(0.0, 1.0)).collect();
+                        crate::io::write_image(
+                            &path,
+                            &image::DynamicImage::ImageRgb8(colormap::heat_map(
+                                &err,
+                                w,
+                                h,
+                                (h / 32).max(4),
+                            )),
+                        )?;
+                        r.map = Some(path);
+                    }
+                }
+                DiffMetric::Msssim => {
+                    r.value = Some(ssim::ms_ssim(&a, &b, ssim::SsimInput::SrgbLuma)?)
+                }
+                DiffMetric::Psnr => {
+                    r.value = Some(mse::mse(&a, &b)?.psnr_db).filter(|v| v.is_finite())
+                }
+                DiffMetric::Mse => r.value = Some(mse::mse(&a, &b)?.mse),
+            }
+            Ok(())
+        };
+        match compute() {
+            Err(Error::Usage(why)) if lenient => r.note = Some(why),
+            other => other?,
+        }
+        out.push(r);
+    }
+    Ok(out)
+}
+
+/// One row of `lodeval bench metrics`.
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct MetricBenchRow {
+    /// Metric name.
+    pub metric: String,
+    /// Image size.
+    pub width: usize,
+    /// Image size.
+    pub height: usize,
+    /// Worker threads.
+    pub threads: usize,
+    /// Mean milliseconds per image pair (both images' preparation included), over `runs`.
+    pub ms_per_pair: f64,
+    /// Timed runs (after one warm-up).
+    pub runs: usize,
+}
+
+/// Time FLIP, SSIM and PSNR on one image pair (decoding excluded). Reporting only.
+pub fn bench_metrics(reference: &Path, test: &Path, runs: usize) -> Result<Vec<MetricBenchRow>> {
+    use crate::metric::{LinearImage, flip::Flip, mse, ssim};
+    let (a, b) = (LinearImage::load(reference)?, LinearImage::load(test)?);
+    let runs = runs.max(1);
+    let time = |f: &dyn Fn() -> Result<f64>| -> Result<f64> {
+        f()?;
+        let start = std::time::Instant::now();
+        for _ in 0..runs {
+            std::hint::black_box(f()?);
+        }
+        Ok(start.elapsed().as_secs_f64() * 1e3 / runs as f64)
+    };
+    let flip = Flip::new(crate::scene::Viewing::DEFAULT.ppd() as f32);
+    let cases: [(&str, &dyn Fn() -> Result<f64>); 3] = [
+        ("flip", &|| flip.compare(&a, &b).map(|s| s.mean)),
+        ("ssim", &|| {
+            ssim::ssim(&a, &b, ssim::SsimInput::SrgbLuma).map(|s| s.0)
+        }),
+        ("psnr", &|| mse::mse(&a, &b).map(|s| s.psnr_db)),
+    ];
+    cases
+        .iter()
+        .map(|(name, f)| {
+            Ok(MetricBenchRow {
+                metric: name.to_string(),
+                width: a.width(),
+                height: a.height(),
+                threads: rayon::current_num_threads(),
+                ms_per_pair: time(*f)?,
+                runs,
+            })
+        })
+        .collect()
+}

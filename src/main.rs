@@ -35,8 +35,8 @@ enum Command {
     Info(InfoArgs),
     /// Render a mesh from the views of a rig with the CPU rasterizer.
     Render(RenderArgs),
-    /// Compare two images with the perceptual metrics (not built yet).
-    Diff(NotYet),
+    /// Compare two images with the perceptual metrics.
+    Diff(DiffArgs),
     /// Run a batch evaluation config (not built yet).
     Eval(NotYet),
     /// Compare renders with golden images, or bless new ones (not built yet).
@@ -107,9 +107,43 @@ struct RenderArgs {
 }
 
 #[derive(Args, Debug)]
+struct DiffArgs {
+    /// Reference image (PNG/JPEG: sRGB; EXR: linear).
+    reference: PathBuf,
+    /// Test image, same size.
+    test: PathBuf,
+    /// Metric: flip, ssim, msssim, psnr, mse, vdp or all.
+    #[arg(long, default_value = "flip")]
+    metric: String,
+    /// Pixels per degree of visual angle (overrides the display flags).
+    #[arg(long, conflicts_with_all = ["display_width_m", "display_px", "distance_m"])]
+    ppd: Option<f64>,
+    /// Display width in metres.
+    #[arg(long, default_value_t = 0.7)]
+    display_width_m: f64,
+    /// Display width in pixels.
+    #[arg(long, default_value_t = 3840.0)]
+    display_px: f64,
+    /// Viewing distance in metres.
+    #[arg(long, default_value_t = 0.7)]
+    distance_m: f64,
+    /// Write a magma heat map of the error here (FLIP error, or 1 − SSIM).
+    #[arg(long)]
+    map: Option<PathBuf>,
+    /// Print JSON (an array, one object per metric).
+    #[arg(long)]
+    json: bool,
+}
+
+#[derive(Args, Debug)]
 struct BenchArgs {
-    /// What to measure: `raster`.
+    /// What to measure: `raster`, or `metrics REF TEST`.
     what: String,
+    /// For `metrics`: the reference and test images.
+    images: Vec<PathBuf>,
+    /// For `metrics`: timed runs per metric.
+    #[arg(long, default_value_t = 5)]
+    runs: usize,
     /// Torus rings (triangles = 2 · rings · sides).
     #[arg(long, default_value_t = 1000)]
     rings: u32,
@@ -287,10 +321,104 @@ fn run(cli: Cli) -> Result<(), Error> {
             }
             Ok(())
         }
+        Command::Diff(a) => {
+            use lodeval::commands::DiffMetric;
+            let metrics: Vec<DiffMetric> = match a.metric.as_str() {
+                "all" => DiffMetric::ALL.to_vec(),
+                "flip" => vec![DiffMetric::Flip],
+                "ssim" => vec![DiffMetric::Ssim],
+                "msssim" => vec![DiffMetric::Msssim],
+                "psnr" => vec![DiffMetric::Psnr],
+                "mse" => vec![DiffMetric::Mse],
+                "vdp" => {
+                    return Err(Error::Usage(
+                        "--metric vdp: the visible-difference predictor is not built yet".into(),
+                    ));
+                }
+                other => {
+                    return Err(Error::Usage(format!(
+                        "--metric {other}: use flip, ssim, msssim, psnr, mse, vdp or all"
+                    )));
+                }
+            };
+            let viewing = match a.ppd {
+                Some(p) if p > 0.0 && p.is_finite() => lodeval::scene::Viewing::from_ppd(p),
+                Some(p) => {
+                    return Err(Error::Usage(format!(
+                        "--ppd {p}: must be a positive number"
+                    )));
+                }
+                None => {
+                    if !(a.display_width_m > 0.0 && a.display_px > 0.0 && a.distance_m > 0.0) {
+                        return Err(Error::Usage(
+                            "display width, pixels and distance must be positive".into(),
+                        ));
+                    }
+                    lodeval::scene::Viewing::from_display(
+                        a.display_width_m,
+                        a.display_px,
+                        a.distance_m,
+                    )
+                }
+            };
+            // With `all`, metrics that do not apply to this image size report a note instead.
+            let lenient = a.metric == "all";
+            let results = lodeval::commands::diff(
+                &a.reference,
+                &a.test,
+                &metrics,
+                &viewing,
+                a.map.as_deref(),
+                lenient,
+            )?;
+            if a.json {
+                emit(
+                    &(serde_json::to_string_pretty(&results)
+                        .map_err(|e| Error::Internal(e.to_string()))?
+                        + "\n"),
+                )
+            } else {
+                let mut text = String::new();
+                for r in &results {
+                    let name = serde_json::to_value(r.metric)
+                        .ok()
+                        .and_then(|v| v.as_str().map(str::to_string))
+                        .unwrap_or_default();
+                    let value = match (r.value, &r.note) {
+                        (Some(v), _) => format!("{v:.6}"),
+                        (None, Some(note)) => format!("-  ({note})"),
+                        (None, None) => "inf".to_string(),
+                    };
+                    text.push_str(&format!("{name:<7} {value}"));
+                    if let Some(p) = &r.percentiles {
+                        text.push_str(&format!(
+                            "  (p95 {:.4}, max {:.4}, {:.2} ppd)",
+                            p["p95"], p["max"], r.ppd
+                        ));
+                    }
+                    if let Some(m) = &r.map {
+                        text.push_str(&format!("  map: {}", m.display()));
+                    }
+                    text.push('\n');
+                }
+                emit(&text)
+            }
+        }
         Command::Bench(a) => {
+            if a.what == "metrics" {
+                let [reference, test] = a.images.as_slice() else {
+                    return Err(Error::Usage(
+                        "lodeval bench metrics REF TEST: give two images".into(),
+                    ));
+                };
+                let rows = lodeval::commands::bench_metrics(reference, test, a.runs)?;
+                let json = serde_json::to_string_pretty(&rows)
+                    .map_err(|e| Error::Internal(e.to_string()))?;
+                return emit(&(json + "\n"));
+            }
             if a.what != "raster" {
                 return Err(Error::Usage(format!(
-                    "lodeval bench {}: the benchmark built so far is `raster`",
+                    "lodeval bench {}: use `raster` or `metrics REF TEST`",
                     a.what
                 )));
             }

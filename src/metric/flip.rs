@@ -25,9 +25,8 @@ use rayon::prelude::*;
 use super::image::{ErrorMap, LinearImage, same_size};
 use crate::error::Result;
 
-/// π as the reference implementation writes it (`f32`).
-#[allow(clippy::excessive_precision)]
-const PI: f32 = 3.14159265358979;
+/// π in `f32` (the reference's literal 3.14159265358979f rounds to the same value).
+const PI: f32 = std::f32::consts::PI;
 /// Colour-difference exponent qc.
 const QC: f32 = 0.7;
 /// Error-remapping knee pc.
@@ -216,7 +215,7 @@ fn feature_filter(ppd: f32) -> Vec<[f32; 3]> {
 /// Horizontal then vertical pass of a separable filter with clamped borders. `pass_x` maps a row
 /// of source values to filtered ones (`K` channels); `pass_y` likewise per column, fed the
 /// horizontal results. Both run over rows in parallel.
-fn separable<S: Sync, I: Send + Sync + Copy + Default, O: Send>(
+fn separable<S: Sync, I: Send + Sync + Copy + Default, O: Send + Copy + Default>(
     width: usize,
     height: usize,
     src: &[S],
@@ -230,14 +229,13 @@ fn separable<S: Sync, I: Send + Sync + Copy + Default, O: Send>(
             *out = pass_x(src_row, x);
         }
     });
-    (0..height)
-        .into_par_iter()
-        .flat_map_iter(|y| {
-            let mid = &mid;
-            let pass_y = &pass_y;
-            (0..width).map(move |x| pass_y(mid, x, y))
-        })
-        .collect()
+    let mut out = vec![O::default(); width * height];
+    out.par_chunks_mut(width).enumerate().for_each(|(y, row)| {
+        for (x, o) in row.iter_mut().enumerate() {
+            *o = pass_y(&mid, x, y);
+        }
+    });
+    out
 }
 
 /// Clamp-to-edge index.

@@ -5,6 +5,7 @@
 //! `pool.rs` (pooling).
 
 pub mod color;
+pub mod colormap;
 pub mod flip;
 mod image;
 pub mod mse;

@@ -17,7 +17,7 @@
 
 use rayon::prelude::*;
 
-use super::color::{linear_to_srgb, luminance};
+use super::color::{linear_to_srgb_fast, luminance};
 use super::image::{LinearImage, same_size};
 use crate::error::{Error, Result};
 
@@ -54,9 +54,9 @@ fn plane(img: &LinearImage, input: SsimInput) -> Plane {
         .par_iter()
         .map(|&c| match input {
             SsimInput::SrgbLuma => {
-                0.2126 * linear_to_srgb(c.x) as f64
-                    + 0.7152 * linear_to_srgb(c.y) as f64
-                    + 0.0722 * linear_to_srgb(c.z) as f64
+                0.2126 * linear_to_srgb_fast(c.x) as f64
+                    + 0.7152 * linear_to_srgb_fast(c.y) as f64
+                    + 0.0722 * linear_to_srgb_fast(c.z) as f64
             }
             SsimInput::LinearLuminance => luminance(c) as f64,
         })
@@ -86,69 +86,100 @@ fn kernel() -> [f64; 2 * RADIUS + 1] {
     k.map(|w| w / s)
 }
 
-/// Separable Gaussian blur of several planes at once (same geometry), reflected borders.
-fn blur<const N: usize>(
-    w: usize,
-    h: usize,
-    src: impl Fn(usize) -> [f64; N] + Sync,
-) -> Vec<[f64; N]> {
-    let k = kernel();
-    let mut mid = vec![[0.0; N]; w * h];
-    mid.par_chunks_mut(w).enumerate().for_each(|(y, row)| {
-        for (x, out) in row.iter_mut().enumerate() {
-            let mut acc = [0.0; N];
-            for (t, &kw) in k.iter().enumerate() {
-                let s = src(y * w + reflect(x as isize + t as isize - RADIUS as isize, w));
-                for c in 0..N {
-                    acc[c] += kw * s[c];
-                }
-            }
-            *out = acc;
-        }
-    });
-    let mut out = vec![[0.0; N]; w * h];
-    out.par_chunks_mut(w).enumerate().for_each(|(y, row)| {
-        for (x, o) in row.iter_mut().enumerate() {
-            let mut acc = [0.0; N];
-            for (t, &kw) in k.iter().enumerate() {
-                let s = mid[reflect(y as isize + t as isize - RADIUS as isize, h) * w + x];
-                for c in 0..N {
-                    acc[c] += kw * s[c];
-                }
-            }
-            *o = acc;
-        }
-    });
-    out
-}
+/// Rows per parallel band of the fused filter-and-score pass.
+const BAND: usize = 16;
 
-/// Per-pixel SSIM terms: (luminance term l, contrast–structure term cs).
-fn terms(a: &Plane, b: &Plane) -> Vec<(f64, f64)> {
+/// Per-pixel SSIM terms, computed band by band: for each band of output rows, the five local
+/// moments (x, y, x², y², xy) are Gaussian-filtered horizontally for the band plus its ±5-row halo
+/// (reflected at the image border, scipy's "reflect"), then vertically, and turned into the
+/// luminance term l and the contrast–structure term cs right away. No full-size moment images are
+/// ever allocated (an earlier version spent more time in page faults than in arithmetic).
+/// Returns the SSIM map (if `want_map`) and, per row, the sums of (l·cs, cs, l) over the columns
+/// at least `RADIUS` from the left and right borders.
+fn terms(a: &Plane, b: &Plane, want_map: bool) -> (Vec<f32>, Vec<[f64; 3]>) {
+    let (w, h) = (a.w, a.h);
     let (c1, c2) = ((K1 * 1.0).powi(2), (K2 * 1.0).powi(2));
-    let m = blur::<5>(a.w, a.h, |i| {
-        let (x, y) = (a.v[i], b.v[i]);
-        [x, y, x * x, y * y, x * y]
-    });
-    m.par_iter()
-        .map(|&[ux, uy, uxx, uyy, uxy]| {
-            let (vx, vy, vxy) = (uxx - ux * ux, uyy - uy * uy, uxy - ux * uy);
-            let l = (2.0 * ux * uy + c1) / (ux * ux + uy * uy + c1);
-            let cs = (2.0 * vxy + c2) / (vx + vy + c2);
-            (l, cs)
+    let k = kernel();
+    let bands: Vec<(Vec<f32>, Vec<[f64; 3]>)> = (0..h.div_ceil(BAND))
+        .into_par_iter()
+        .map(|band| {
+            let (y0, y1) = (band * BAND, ((band + 1) * BAND).min(h));
+            // Horizontal pass over the band and its halo; each row padded once.
+            let rows = y1 - y0 + 2 * RADIUS;
+            let mut mid = vec![0.0f64; rows * w * 5];
+            let mut padded = vec![0.0f64; (w + 2 * RADIUS) * 5];
+            let columns: Vec<usize> = (0..w + 2 * RADIUS)
+                .map(|i| reflect(i as isize - RADIUS as isize, w))
+                .collect();
+            for r in 0..rows {
+                let y = reflect((y0 + r) as isize - RADIUS as isize, h);
+                for (p, &col) in padded.chunks_exact_mut(5).zip(&columns) {
+                    let idx = y * w + col;
+                    let (x, yv) = (a.v[idx], b.v[idx]);
+                    p.copy_from_slice(&[x, yv, x * x, yv * yv, x * yv]);
+                }
+                let out = &mut mid[r * w * 5..(r + 1) * w * 5];
+                for (t, &kw) in k.iter().enumerate() {
+                    for (o, &s) in out.iter_mut().zip(&padded[t * 5..t * 5 + w * 5]) {
+                        *o += kw * s;
+                    }
+                }
+            }
+            // Vertical pass and the SSIM terms, row by row.
+            let mut map = Vec::with_capacity(if want_map { (y1 - y0) * w } else { 0 });
+            let mut sums = Vec::with_capacity(y1 - y0);
+            let mut acc = vec![0.0f64; w * 5];
+            for y in y0..y1 {
+                acc.fill(0.0);
+                for (t, &kw) in k.iter().enumerate() {
+                    let r = y - y0 + t;
+                    for (o, &s) in acc.iter_mut().zip(&mid[r * w * 5..(r + 1) * w * 5]) {
+                        *o += kw * s;
+                    }
+                }
+                let mut row_sum = [0.0f64; 3];
+                for (x, m) in acc.chunks_exact(5).enumerate() {
+                    let (ux, uy, uxx, uyy, uxy) = (m[0], m[1], m[2], m[3], m[4]);
+                    let (vx, vy, vxy) = (uxx - ux * ux, uyy - uy * uy, uxy - ux * uy);
+                    let l = (2.0 * ux * uy + c1) / (ux * ux + uy * uy + c1);
+                    let cs = (2.0 * vxy + c2) / (vx + vy + c2);
+                    if want_map {
+                        map.push((l * cs) as f32);
+                    }
+                    if x >= RADIUS && x + RADIUS < w {
+                        row_sum[0] += l * cs;
+                        row_sum[1] += cs;
+                        row_sum[2] += l;
+                    }
+                }
+                sums.push(row_sum);
+            }
+            (map, sums)
         })
-        .collect()
+        .collect();
+    let mut map = Vec::with_capacity(if want_map { w * h } else { 0 });
+    let mut sums = Vec::with_capacity(h);
+    for (m, s) in bands {
+        map.extend(m);
+        sums.extend(s);
+    }
+    (map, sums)
 }
 
-/// Mean over the pixels at least `RADIUS` from every border (rows summed in order).
-fn cropped_mean(w: usize, h: usize, v: &[f64]) -> Option<f64> {
+/// Means of (l·cs, cs, l) over the pixels at least `RADIUS` from every border (rows in order);
+/// `None` when no such pixel exists.
+fn cropped_means(w: usize, h: usize, sums: &[[f64; 3]]) -> Option<[f64; 3]> {
     if w <= 2 * RADIUS || h <= 2 * RADIUS {
         return None;
     }
-    let rows: Vec<f64> = (RADIUS..h - RADIUS)
-        .into_par_iter()
-        .map(|y| v[y * w + RADIUS..y * w + w - RADIUS].iter().sum())
-        .collect();
-    Some(rows.iter().sum::<f64>() / ((w - 2 * RADIUS) * (h - 2 * RADIUS)) as f64)
+    let mut total = [0.0; 3];
+    for s in &sums[RADIUS..h - RADIUS] {
+        for c in 0..3 {
+            total[c] += s[c];
+        }
+    }
+    let n = ((w - 2 * RADIUS) * (h - 2 * RADIUS)) as f64;
+    Some(total.map(|t| t / n))
 }
 
 fn too_small(w: usize, h: usize, what: &str) -> Error {
@@ -158,7 +189,7 @@ fn too_small(w: usize, h: usize, what: &str) -> Error {
     ))
 }
 
-/// Mean SSIM in [−1, 1] (1 = identical) and, if wanted, the per-pixel SSIM map.
+/// Mean SSIM in [−1, 1] (1 = identical) and the per-pixel SSIM map.
 pub fn ssim(
     reference: &LinearImage,
     test: &LinearImage,
@@ -166,9 +197,9 @@ pub fn ssim(
 ) -> Result<(f64, Vec<f32>)> {
     same_size(reference, test)?;
     let (a, b) = (plane(reference, input), plane(test, input));
-    let s: Vec<f64> = terms(&a, &b).iter().map(|&(l, cs)| l * cs).collect();
-    let mean = cropped_mean(a.w, a.h, &s).ok_or_else(|| too_small(a.w, a.h, "SSIM"))?;
-    Ok((mean, s.iter().map(|&v| v as f32).collect()))
+    let (map, sums) = terms(&a, &b, true);
+    let [mean, _, _] = cropped_means(a.w, a.h, &sums).ok_or_else(|| too_small(a.w, a.h, "SSIM"))?;
+    Ok((mean, map))
 }
 
 /// 2×2 box average (odd trailing row/column dropped), as between MS-SSIM scales.
@@ -198,13 +229,10 @@ pub fn ms_ssim(reference: &LinearImage, test: &LinearImage, input: SsimInput) ->
     }
     let mut product = 1.0;
     for (scale, &weight) in MS_WEIGHTS.iter().enumerate() {
-        let t = terms(&a, &b);
-        let cs: Vec<f64> = t.iter().map(|&(_, cs)| cs).collect();
-        let mean_cs = cropped_mean(a.w, a.h, &cs).ok_or_else(|| too_small(a.w, a.h, "MS-SSIM"))?;
+        let (_, sums) = terms(&a, &b, false);
+        let [_, mean_cs, mean_l] =
+            cropped_means(a.w, a.h, &sums).ok_or_else(|| too_small(a.w, a.h, "MS-SSIM"))?;
         if scale + 1 == MS_WEIGHTS.len() {
-            let l: Vec<f64> = t.iter().map(|&(l, _)| l).collect();
-            let mean_l =
-                cropped_mean(a.w, a.h, &l).ok_or_else(|| too_small(a.w, a.h, "MS-SSIM"))?;
             product *= (mean_l * mean_cs).max(0.0).powf(weight);
         } else {
             product *= mean_cs.max(0.0).powf(weight);

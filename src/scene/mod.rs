@@ -4,10 +4,12 @@
 mod camera;
 mod light;
 mod rig;
+mod viewing;
 
 pub use camera::{Camera, Projection};
 pub use light::{HEADLIGHT_OFFSET, Light};
 pub use rig::Rig;
+pub use viewing::Viewing;
 
 use std::sync::Arc;
 

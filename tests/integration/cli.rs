@@ -54,7 +54,7 @@ fn zero_threads_is_a_usage_error() {
 
 #[test]
 fn unbuilt_subcommands_say_so_and_exit_2() {
-    for cmd in ["diff", "eval", "golden", "simplify", "optimize", "merge"] {
+    for cmd in ["eval", "golden", "simplify", "optimize", "merge"] {
         let r = lodeval([cmd, "whatever", "--flag"]);
         assert_eq!(r.code, 2, "{cmd}: {}", r.stderr);
         assert!(r.stderr.contains("not built yet"), "{cmd}: {}", r.stderr);
@@ -115,5 +115,90 @@ fn ci_runs_the_readme_test_command() {
     assert!(
         quick_start.contains(ci_test.trim()),
         "README quick start lacks `{ci_test}`"
+    );
+}
+
+#[test]
+fn diff_reports_every_metric_as_json_and_writes_maps() {
+    let dir = tempfile::tempdir().unwrap();
+    let o = |f: &str| crate::common::root().join("reference/oracles/flip").join(f);
+    let (r, t) = (o("lines_70_ref.png"), o("lines_70_test.png"));
+    let map = dir.path().join("err.png");
+    let run = lodeval([
+        "diff".as_ref(),
+        r.as_os_str(),
+        t.as_os_str(),
+        "--metric".as_ref(),
+        "all".as_ref(),
+        "--json".as_ref(),
+        "--map".as_ref(),
+        map.as_os_str(),
+        "--ppd".as_ref(),
+        "40".as_ref(),
+    ]);
+    assert_eq!(run.code, 0, "{}", run.stderr);
+    let v: serde_json::Value = serde_json::from_str(&run.stdout).unwrap();
+    let names: Vec<&str> = v
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|m| m["metric"].as_str().unwrap())
+        .collect();
+    assert_eq!(names, ["flip", "ssim", "msssim", "psnr", "mse"]);
+    for m in v.as_array().unwrap() {
+        assert_eq!(m["ppd"], 40.0);
+        assert_eq!(
+            (m["width"].as_u64(), m["height"].as_u64()),
+            (Some(70), Some(70))
+        );
+    }
+    assert!(v[0]["percentiles"]["p95"].as_f64().unwrap() > 0.0);
+    // 70×70 is too small for MS-SSIM's five scales: no value, a note, and still exit 0.
+    assert!(v[2]["value"].is_null() && v[2]["note"].as_str().unwrap().contains("176x176"));
+    assert!(dir.path().join("err-flip.png").exists() && dir.path().join("err-ssim.png").exists());
+}
+
+#[test]
+fn diff_rejects_bad_requests_with_exit_2() {
+    let o = |f: &str| crate::common::root().join("reference/oracles/flip").join(f);
+    let (a, b) = (o("lines_70_ref.png"), o("noise_64x48_ref.png"));
+    let r = lodeval(["diff".as_ref(), a.as_os_str(), b.as_os_str()]);
+    assert_eq!(r.code, 2, "{}", r.stderr);
+    assert!(
+        r.stderr.contains("noise_64x48_ref.png") && r.stderr.contains("64x48"),
+        "{}",
+        r.stderr
+    );
+    let r = lodeval([
+        "diff".as_ref(),
+        a.as_os_str(),
+        a.as_os_str(),
+        "--metric".as_ref(),
+        "vdp".as_ref(),
+    ]);
+    assert!(
+        r.code == 2 && r.stderr.contains("not built yet"),
+        "{}",
+        r.stderr
+    );
+    let r = lodeval(["diff".as_ref(), a.as_os_str(), "missing.png".as_ref()]);
+    assert!(
+        r.code == 2 && r.stderr.contains("missing.png"),
+        "{}",
+        r.stderr
+    );
+    // SSIM needs an 11×11 window: a 3×2 pair is a usage error, FLIP is fine.
+    let (t1, t2) = (o("tiny_3x2_ref.png"), o("tiny_3x2_test.png"));
+    let r = lodeval([
+        "diff".as_ref(),
+        t1.as_os_str(),
+        t2.as_os_str(),
+        "--metric".as_ref(),
+        "ssim".as_ref(),
+    ]);
+    assert!(r.code == 2 && r.stderr.contains("11x11"), "{}", r.stderr);
+    assert_eq!(
+        lodeval(["diff".as_ref(), t1.as_os_str(), t2.as_os_str()]).code,
+        0
     );
 }
