@@ -6,6 +6,7 @@
 
 pub mod color;
 pub mod colormap;
+pub mod csf;
 pub mod flip;
 mod image;
 pub mod mse;

@@ -1,0 +1,205 @@
+//! Contrast sensitivity functions (CSFs) used by the perceptual simplifiers, with inverse lookups
+//! from a contrast to the highest spatial frequency at which it is still visible.
+//!
+//! Based on:
+//! - Scott Daly. The Visible Differences Predictor. Digital Images and Human Vision 1993, in the
+//!   approximation of Holly Rushmeier, Greg Ward, Christine Piatko, Phil Sanders, Bert Rust.
+//!   Comparing Real and Synthetic Images. Eurographics Rendering Workshop 1995, as Williams et al.
+//!   2003 §3 write it: C(f) = (0.008/f^1.5 + 1)^−0.2 · 1.42·f · e^(−0.3f) · √(1 + 0.06·e^(0.3f)),
+//!   f in cycles per degree. Decision: the project's text copy of the paper prints √f inside the
+//!   three frequency terms; with √f the function would peak near 13 cpd, while the paper itself
+//!   says sensitivity peaks at 2–4 cpd and Daly's CSF has the form a·ρ·e^(−bρ)·√(1 + 0.06·e^(bρ))
+//!   in ρ itself — so the √ is taken as a transcription artefact and f is used (peak ≈ 3.5 cpd).
+//!   The function is normalised (peak ≈ 1.9), not absolute: callers that need absolute threshold
+//!   contrasts scale it by a peak sensitivity (Daly's P), as the simplifier issues will decide.
+//!   Williams et al. evaluate it through a lookup table and clamp it below the peak (their Fig. 3):
+//!   lower frequencies get the peak sensitivity, so threshold contrast falls monotonically with
+//!   frequency and the inverse is single valued.
+//! - Nicolas Menzel, Michael Guthe. Towards Perceptual Simplification of Models with Arbitrary
+//!   Materials. Pacific Graphics 2010, §4.3 and Table 1: the Burbeck–Kelly (1980) achromatic and
+//!   chromatic CSFs, maximised over temporal frequency, fitted as sums of Gaussians
+//!   C(f) ≈ Σ_i w_i·exp(−f²/σ_i²) — achromatic (w, σ) = (1.98488, 9.45161), (1.06781, 7.07609),
+//!   (−1.18094, 3.14760); chromatic (0.27519, 7.00112), (0.24116, 3.78524). Values are in the
+//!   paper's normalisation; as there, they are compared with its JND-scaled signal differences.
+//!
+//! The lookup tables sample frequency logarithmically from [`F_MIN`] to [`F_MAX`] cycles per degree.
+
+/// Lowest tabulated frequency, cycles per degree.
+pub const F_MIN: f64 = 0.01;
+/// Highest tabulated frequency, cycles per degree.
+pub const F_MAX: f64 = 100.0;
+const TABLE_SIZE: usize = 2048;
+
+/// Daly's CSF in Rushmeier et al.'s approximation (unclamped).
+pub fn daly_rushmeier(f: f64) -> f64 {
+    if f <= 0.0 {
+        return 0.0;
+    }
+    (0.008 / f.powf(1.5) + 1.0).powf(-0.2)
+        * 1.42
+        * f
+        * (-0.3 * f).exp()
+        * (1.0 + 0.06 * (0.3 * f).exp()).sqrt()
+}
+
+/// Menzel–Guthe Table 1 fit of the Burbeck–Kelly achromatic CSF.
+pub fn burbeck_kelly_achromatic(f: f64) -> f64 {
+    [(1.98488, 9.45161), (1.06781, 7.07609), (-1.18094, 3.14760)]
+        .iter()
+        .map(|&(w, s): &(f64, f64)| w * (-(f * f) / (s * s)).exp())
+        .sum()
+}
+
+/// Menzel–Guthe Table 1 fit of the Burbeck–Kelly chromatic CSF.
+pub fn burbeck_kelly_chromatic(f: f64) -> f64 {
+    [(0.27519, 7.00112), (0.24116, 3.78524)]
+        .iter()
+        .map(|&(w, s): &(f64, f64)| w * (-(f * f) / (s * s)).exp())
+        .sum()
+}
+
+/// A CSF sampled into a table and clamped to its peak below the peak frequency, so that it is
+/// non-increasing in frequency and can be inverted.
+///
+/// # Guarantees
+/// - `sensitivity` is non-increasing in frequency; `peak_frequency()` is where the raw CSF peaks.
+#[derive(Debug, Clone)]
+pub struct ClampedCsf {
+    freqs: Vec<f64>,
+    values: Vec<f64>,
+    peak_f: f64,
+}
+
+impl ClampedCsf {
+    /// Tabulate `csf` and clamp it below its peak.
+    pub fn new(csf: impl Fn(f64) -> f64) -> ClampedCsf {
+        let freqs: Vec<f64> = (0..TABLE_SIZE)
+            .map(|i| F_MIN * (F_MAX / F_MIN).powf(i as f64 / (TABLE_SIZE - 1) as f64))
+            .collect();
+        let raw: Vec<f64> = freqs.iter().map(|&f| csf(f)).collect();
+        let peak = (0..raw.len()).fold(0, |best, i| if raw[i] > raw[best] { i } else { best });
+        // Clamp below the peak, and enforce monotonicity above it (flat segments stay flat).
+        let mut values = raw.clone();
+        for v in values.iter_mut().take(peak) {
+            *v = raw[peak];
+        }
+        for i in peak + 1..values.len() {
+            values[i] = values[i].min(values[i - 1]);
+        }
+        ClampedCsf {
+            peak_f: freqs[peak],
+            freqs,
+            values,
+        }
+    }
+
+    /// Daly's CSF (Rushmeier et al. approximation), clamped below the peak: Williams et al. 2003.
+    pub fn daly() -> ClampedCsf {
+        ClampedCsf::new(daly_rushmeier)
+    }
+
+    /// Frequency of the raw CSF's peak, cycles per degree (table resolution).
+    pub fn peak_frequency(&self) -> f64 {
+        self.peak_f
+    }
+
+    /// Clamped sensitivity at `f` cycles per degree (log-linear interpolation; 0 above F_MAX).
+    pub fn sensitivity(&self, f: f64) -> f64 {
+        if f <= self.freqs[0] {
+            return self.values[0];
+        }
+        if f >= F_MAX {
+            return if f == F_MAX {
+                *self.values.last().unwrap_or(&0.0)
+            } else {
+                0.0
+            };
+        }
+        let t = (f / F_MIN).ln() / (F_MAX / F_MIN).ln() * (TABLE_SIZE - 1) as f64;
+        let i = (t.floor() as usize).min(TABLE_SIZE - 2);
+        let u = t - i as f64;
+        self.values[i] * (1.0 - u) + self.values[i + 1] * u
+    }
+
+    /// Threshold contrast at `f`: 1 / sensitivity (∞ where the table is 0).
+    pub fn threshold(&self, f: f64) -> f64 {
+        1.0 / self.sensitivity(f)
+    }
+
+    /// The highest spatial frequency at which a stimulus of `contrast` is at or above threshold,
+    /// i.e. the f with sensitivity(f) · contrast = 1 (Luebke & Hallen's inversion, used by
+    /// Williams et al. §3.3). `None` if the contrast is below threshold at every frequency;
+    /// `Some(F_MAX)` if it is visible up to the end of the table.
+    pub fn max_visible_frequency(&self, contrast: f64) -> Option<f64> {
+        if !(contrast > 0.0) || self.values[0] * contrast < 1.0 {
+            return None;
+        }
+        let needed = 1.0 / contrast;
+        // First table entry below the needed sensitivity (values are non-increasing).
+        let k = self.values.partition_point(|&v| v >= needed);
+        if k >= self.values.len() {
+            return Some(F_MAX);
+        }
+        // Interpolate between entries k−1 (≥ needed) and k (< needed) in log frequency.
+        let (v0, v1) = (self.values[k - 1], self.values[k]);
+        let u = if v0 > v1 {
+            (v0 - needed) / (v0 - v1)
+        } else {
+            0.0
+        };
+        Some((self.freqs[k - 1].ln() * (1.0 - u) + self.freqs[k].ln() * u).exp())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn daly_peaks_at_a_few_cycles_per_degree_and_is_clamped_below() {
+        // Williams et al. §3.2: "peak contrast sensitivity occurs around 2-4 cycles per degree".
+        let csf = ClampedCsf::daly();
+        let peak = csf.peak_frequency();
+        assert!((2.0..=5.0).contains(&peak), "{peak}");
+        let s = daly_rushmeier(peak);
+        // Clamped: lower frequencies get the peak value, although the raw CSF falls there.
+        assert!(daly_rushmeier(0.1) < s * 0.6);
+        assert!((csf.sensitivity(0.1) - s).abs() < 1e-9);
+        // High frequencies are far less visible: at 30 cpd below a tenth of the peak.
+        assert!(csf.sensitivity(30.0) < 0.1 * s);
+    }
+
+    #[test]
+    fn inverse_lookup_inverts_and_is_monotone() {
+        // Scaled to an absolute peak sensitivity of 250 (Daly's P), so contrasts are physical.
+        let peak_s = daly_rushmeier(ClampedCsf::daly().peak_frequency());
+        let csf = ClampedCsf::new(|f| 250.0 / peak_s * daly_rushmeier(f));
+        let mut last = 0.0;
+        for c in [0.005, 0.01, 0.03, 0.1, 0.3, 0.9] {
+            let f = csf.max_visible_frequency(c).unwrap();
+            // Higher contrast stays visible to higher frequency.
+            assert!(f > last, "{c}: {f}");
+            last = f;
+            // At that frequency the contrast is exactly at threshold (table interpolation).
+            assert!(
+                (csf.sensitivity(f) * c - 1.0).abs() < 2e-3,
+                "{c}: {}",
+                csf.sensitivity(f) * c
+            );
+        }
+        // Below the peak threshold (1/250) nothing is visible at any frequency.
+        assert_eq!(csf.max_visible_frequency(0.9 / 250.0), None);
+    }
+
+    #[test]
+    fn burbeck_kelly_fit_matches_table_1_at_zero_and_falls_off() {
+        // At f = 0 each fit is the sum of its weights.
+        assert!((burbeck_kelly_achromatic(0.0) - (1.98488 + 1.06781 - 1.18094)).abs() < 1e-12);
+        assert!((burbeck_kelly_chromatic(0.0) - (0.27519 + 0.24116)).abs() < 1e-12);
+        // Chromatic sensitivity falls off faster than achromatic at high frequency (colour
+        // vision has lower spatial resolution).
+        assert!(burbeck_kelly_chromatic(15.0) < burbeck_kelly_achromatic(15.0));
+        let a = ClampedCsf::new(burbeck_kelly_achromatic);
+        assert!(a.max_visible_frequency(1.0).is_some());
+    }
+}
