@@ -131,7 +131,8 @@ impl ClampedCsf {
     /// Williams et al. §3.3). `None` if the contrast is below threshold at every frequency;
     /// `Some(F_MAX)` if it is visible up to the end of the table.
     pub fn max_visible_frequency(&self, contrast: f64) -> Option<f64> {
-        if !(contrast > 0.0) || self.values[0] * contrast < 1.0 {
+        // NaN and non-positive contrasts are never visible.
+        if contrast.is_nan() || contrast <= 0.0 || self.values[0] * contrast < 1.0 {
             return None;
         }
         let needed = 1.0 / contrast;
