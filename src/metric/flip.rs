@@ -22,6 +22,7 @@
 use glam::Vec3;
 use rayon::prelude::*;
 
+use super::color::{rgb_to_xyz, xyz_to_lab, xyz_to_rgb, xyz_to_ycxcz, ycxcz_to_xyz};
 use super::image::{ErrorMap, LinearImage, same_size};
 use crate::error::Result;
 
@@ -42,80 +43,6 @@ const A1: [f32; 3] = [1.0, 1.0, 34.1];
 const B1: [f32; 3] = [0.0047, 0.0053, 0.04];
 const A2: [f32; 3] = [0.0, 0.0, 13.5];
 const B2: [f32; 3] = [1.0e-5, 1.0e-5, 0.025];
-
-/// D65 reference white and its inverse, as the reference implementation gives them.
-/// (Digits exactly as the reference writes them: FLIP's error at nearly identical pixels is very
-/// sensitive to the last bit of every constant.)
-#[allow(clippy::excessive_precision)]
-const WHITE: Vec3 = Vec3::new(0.950428545, 1.000000000, 1.088900371);
-#[allow(clippy::excessive_precision)]
-const INV_WHITE: Vec3 = Vec3::new(1.052156925, 1.000000000, 0.918357670);
-
-/// Linear sRGB → CIE XYZ (D65).
-fn rgb_to_xyz(c: Vec3) -> Vec3 {
-    let m = [
-        [
-            10_135_552.0 / 24_577_794.0,
-            8_788_810.0 / 24_577_794.0,
-            4_435_075.0 / 24_577_794.0,
-        ],
-        [
-            2_613_072.0 / 12_288_897.0,
-            8_788_810.0 / 12_288_897.0,
-            887_015.0 / 12_288_897.0,
-        ],
-        [
-            1_425_312.0 / 73_733_382.0,
-            8_788_810.0 / 73_733_382.0,
-            70_074_185.0 / 73_733_382.0,
-        ],
-    ];
-    Vec3::new(
-        m[0][0] * c.x + m[0][1] * c.y + m[0][2] * c.z,
-        m[1][0] * c.x + m[1][1] * c.y + m[1][2] * c.z,
-        m[2][0] * c.x + m[2][1] * c.y + m[2][2] * c.z,
-    )
-}
-
-/// CIE XYZ → linear sRGB (D65).
-#[allow(clippy::excessive_precision)]
-fn xyz_to_rgb(c: Vec3) -> Vec3 {
-    Vec3::new(
-        3.241003275 * c.x + -1.537398934 * c.y + -0.498615861 * c.z,
-        -0.969224334 * c.x + 1.875930071 * c.y + 0.041554224 * c.z,
-        0.055639423 * c.x + -0.204011202 * c.y + 1.057148933 * c.z,
-    )
-}
-
-/// XYZ → YCxCz (the linearised CIELAB of Zhang & Wandell's S-CIELAB).
-fn xyz_to_ycxcz(c: Vec3) -> Vec3 {
-    let c = c * INV_WHITE;
-    Vec3::new(116.0 * c.y - 16.0, 500.0 * (c.x - c.y), 200.0 * (c.y - c.z))
-}
-
-fn ycxcz_to_xyz(c: Vec3) -> Vec3 {
-    let y = (c.x + 16.0) / 116.0;
-    Vec3::new(y + c.y / 500.0, y, y - c.z / 200.0) * WHITE
-}
-
-/// XYZ → CIELAB (D65).
-fn xyz_to_lab(c: Vec3) -> Vec3 {
-    let delta = 6.0f32 / 29.0;
-    let delta_sq = delta * delta;
-    let delta_cube = delta * delta_sq;
-    let factor = 1.0 / (3.0 * delta_sq);
-    let term = 4.0f32 / 29.0;
-    let c = c * INV_WHITE;
-    let f = |v: f32| {
-        if v > delta_cube {
-            v.powf(1.0 / 3.0)
-        } else {
-            factor * v + term
-        }
-    };
-    let (x, y, z) = (f(c.x), f(c.y), f(c.z));
-    Vec3::new(116.0 * y - 16.0, 500.0 * (x - y), 200.0 * (y - z))
-}
 
 /// Hunt-adjusted CIELAB: chroma scaled by 0.01·L (paper §3.2).
 fn hunt(lab: Vec3) -> Vec3 {
