@@ -291,16 +291,19 @@ pub enum DiffMetric {
     Psnr,
     /// MSE of linear luminance.
     Mse,
+    /// Visible-difference predictor: value = detection probability in [0, 1]; `jnd` also given.
+    Vdp,
 }
 
 impl DiffMetric {
     /// Every metric `diff` can compute, in output order.
-    pub const ALL: [DiffMetric; 5] = [
+    pub const ALL: [DiffMetric; 6] = [
         DiffMetric::Flip,
         DiffMetric::Ssim,
         DiffMetric::Msssim,
         DiffMetric::Psnr,
         DiffMetric::Mse,
+        DiffMetric::Vdp,
     ];
 }
 
@@ -320,6 +323,9 @@ pub struct DiffResult {
     /// FLIP only: percentiles p25, p50, p75, p95, p99 and the maximum of the error map.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub percentiles: Option<std::collections::BTreeMap<String, f64>>,
+    /// VDP only: the difference in just-noticeable differences.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub jnd: Option<f64>,
     /// FLIP only: histogram of the error map, 20 bins over [0, 1].
     #[serde(skip_serializing_if = "Option::is_none")]
     pub histogram: Option<Vec<u64>>,
@@ -386,6 +392,7 @@ pub fn diff(
             histogram: None,
             map: None,
             note: None,
+            jnd: None,
         };
         let mut compute = || -> Result<()> {
             match metric {
@@ -438,6 +445,18 @@ pub fn diff(
                     r.value = Some(mse::mse(&a, &b)?.psnr_db).filter(|v| v.is_finite())
                 }
                 DiffMetric::Mse => r.value = Some(mse::mse(&a, &b)?.mse),
+                DiffMetric::Vdp => {
+                    let s =
+                        crate::metric::vdp::Vdp::new(viewing, crate::metric::vdp::Display::DEFAULT)
+                            .compare(&a, &b)?;
+                    r.value = Some(s.probability);
+                    r.jnd = Some(s.jnd);
+                    if let Some(path) = map_path(metric) {
+                        let img = colormap::heat_map(&s.map.values, w, h, (h / 32).max(4));
+                        crate::io::write_image(&path, &image::DynamicImage::ImageRgb8(img))?;
+                        r.map = Some(path);
+                    }
+                }
             }
             Ok(())
         };
@@ -481,8 +500,13 @@ pub fn bench_metrics(reference: &Path, test: &Path, runs: usize) -> Result<Vec<M
         Ok(start.elapsed().as_secs_f64() * 1e3 / runs as f64)
     };
     let flip = Flip::new(crate::scene::Viewing::DEFAULT.ppd() as f32);
-    let cases: [(&str, &dyn Fn() -> Result<f64>); 3] = [
+    let vdp = crate::metric::vdp::Vdp::new(
+        &crate::scene::Viewing::DEFAULT,
+        crate::metric::vdp::Display::DEFAULT,
+    );
+    let cases: [(&str, &dyn Fn() -> Result<f64>); 4] = [
         ("flip", &|| flip.compare(&a, &b).map(|s| s.mean)),
+        ("vdp", &|| vdp.compare(&a, &b).map(|s| s.jnd)),
         ("ssim", &|| {
             ssim::ssim(&a, &b, ssim::SsimInput::SrgbLuma).map(|s| s.0)
         }),

@@ -330,11 +330,7 @@ fn run(cli: Cli) -> Result<(), Error> {
                 "msssim" => vec![DiffMetric::Msssim],
                 "psnr" => vec![DiffMetric::Psnr],
                 "mse" => vec![DiffMetric::Mse],
-                "vdp" => {
-                    return Err(Error::Usage(
-                        "--metric vdp: the visible-difference predictor is not built yet".into(),
-                    ));
-                }
+                "vdp" => vec![DiffMetric::Vdp],
                 other => {
                     return Err(Error::Usage(format!(
                         "--metric {other}: use flip, ssim, msssim, psnr, mse, vdp or all"
@@ -395,6 +391,9 @@ fn run(cli: Cli) -> Result<(), Error> {
                             "  (p95 {:.4}, max {:.4}, {:.2} ppd)",
                             p["p95"], p["max"], r.ppd
                         ));
+                    }
+                    if let Some(j) = r.jnd {
+                        text.push_str(&format!("  ({j:.3} JND, {:.2} ppd)", r.ppd));
                     }
                     if let Some(m) = &r.map {
                         text.push_str(&format!("  map: {}", m.display()));

@@ -12,5 +12,6 @@ mod image;
 pub mod mse;
 pub mod pool;
 pub mod ssim;
+pub mod vdp;
 
 pub use image::{ErrorMap, LinearImage};

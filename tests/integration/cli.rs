@@ -144,7 +144,8 @@ fn diff_reports_every_metric_as_json_and_writes_maps() {
         .iter()
         .map(|m| m["metric"].as_str().unwrap())
         .collect();
-    assert_eq!(names, ["flip", "ssim", "msssim", "psnr", "mse"]);
+    assert_eq!(names, ["flip", "ssim", "msssim", "psnr", "mse", "vdp"]);
+    assert!(v[5]["jnd"].as_f64().unwrap() > 0.0 && v[5]["value"].as_f64().unwrap() <= 1.0);
     for m in v.as_array().unwrap() {
         assert_eq!(m["ppd"], 40.0);
         assert_eq!(
@@ -155,7 +156,9 @@ fn diff_reports_every_metric_as_json_and_writes_maps() {
     assert!(v[0]["percentiles"]["p95"].as_f64().unwrap() > 0.0);
     // 70×70 is too small for MS-SSIM's five scales: no value, a note, and still exit 0.
     assert!(v[2]["value"].is_null() && v[2]["note"].as_str().unwrap().contains("176x176"));
-    assert!(dir.path().join("err-flip.png").exists() && dir.path().join("err-ssim.png").exists());
+    for m in ["flip", "ssim", "vdp"] {
+        assert!(dir.path().join(format!("err-{m}.png")).exists(), "{m}");
+    }
 }
 
 #[test]
@@ -174,10 +177,10 @@ fn diff_rejects_bad_requests_with_exit_2() {
         a.as_os_str(),
         a.as_os_str(),
         "--metric".as_ref(),
-        "vdp".as_ref(),
+        "nope".as_ref(),
     ]);
     assert!(
-        r.code == 2 && r.stderr.contains("not built yet"),
+        r.code == 2 && r.stderr.contains("--metric nope"),
         "{}",
         r.stderr
     );

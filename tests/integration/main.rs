@@ -9,6 +9,7 @@
 //! - `oracles`: metrics against reference implementations (FLIP: NVIDIA's; SSIM/PSNR: scikit-image).
 //! - `raster`: the CPU rasterizer (determinism over thread counts, watertightness, golden images,
 //!   the `render` CLI).
+//! - `vdp`: the visible-difference predictor against established psychophysics.
 
 mod bad_input;
 mod cli;
@@ -17,3 +18,4 @@ mod fuzz;
 mod models;
 mod oracles;
 mod raster;
+mod vdp;
