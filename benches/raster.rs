@@ -16,21 +16,6 @@ fn main() {
         shading: Shading::Gouraud,
         export: None,
     };
-    println!(
-        "| triangles | size | samples | views | threads | ms/frame | Mtri/s | 16×16 region µs |"
-    );
-    println!("|---|---|---|---|---|---|---|---|");
-    for r in bench_raster(&job).expect("benchmark runs") {
-        println!(
-            "| {} | {} | {} | {} | {} | {:.1} | {:.1} | {:.0} |",
-            r.triangles,
-            r.size,
-            r.samples,
-            r.views,
-            r.threads,
-            r.ms_per_frame,
-            r.mtri_per_s,
-            r.region_16_us
-        );
-    }
+    let rows = bench_raster(&job).expect("benchmark runs");
+    print!("{}", lodeval::commands::raster_bench_table(&rows));
 }

@@ -225,6 +225,28 @@ pub fn bench_raster(b: &RasterBench) -> Result<Vec<RasterBenchRow>> {
     Ok(rows)
 }
 
+/// The rows of `lodeval bench raster` as a Markdown table.
+pub fn raster_bench_table(rows: &[RasterBenchRow]) -> String {
+    let mut text = String::from(
+        "| triangles | size | samples | views | threads | ms/frame | frames/s | Mtri/s | 16×16 region µs |\n|---|---|---|---|---|---|---|---|---|\n",
+    );
+    for r in rows {
+        text.push_str(&format!(
+            "| {} | {} | {} | {} | {} | {:.1} | {:.2} | {:.1} | {:.0} |\n",
+            r.triangles,
+            r.size,
+            r.samples,
+            r.views,
+            r.threads,
+            r.ms_per_frame,
+            r.frames_per_s,
+            r.mtri_per_s,
+            r.region_16_us
+        ));
+    }
+    text
+}
+
 /// Peak resident set size of this process in MiB (Linux `VmHWM`), if known.
 pub fn peak_rss_mib() -> Option<f64> {
     let status = std::fs::read_to_string("/proc/self/status").ok()?;

@@ -444,29 +444,12 @@ fn run(cli: Cli) -> Result<(), Error> {
             };
             let rows = lodeval::commands::bench_raster(&job)?;
             let rss = lodeval::commands::peak_rss_mib().unwrap_or(f64::NAN);
-            let mut text = String::new();
-            if a.json {
-                text = serde_json::to_string_pretty(&rows)
-                    .map_err(|e| Error::Internal(e.to_string()))?
-                    + "\n";
+            let text = if a.json {
+                serde_json::to_string_pretty(&rows).map_err(|e| Error::Internal(e.to_string()))?
+                    + "\n"
             } else {
-                text.push_str("| triangles | size | samples | views | threads | ms/frame | frames/s | Mtri/s | 16×16 region µs |\n|---|---|---|---|---|---|---|---|---|\n");
-                for r in &rows {
-                    text.push_str(&format!(
-                        "| {} | {} | {} | {} | {} | {:.1} | {:.2} | {:.1} | {:.0} |\n",
-                        r.triangles,
-                        r.size,
-                        r.samples,
-                        r.views,
-                        r.threads,
-                        r.ms_per_frame,
-                        r.frames_per_s,
-                        r.mtri_per_s,
-                        r.region_16_us
-                    ));
-                }
-                text.push_str(&format!("peak RSS: {rss:.0} MiB\n"));
-            }
+                lodeval::commands::raster_bench_table(&rows) + &format!("peak RSS: {rss:.0} MiB\n")
+            };
             emit(&text)
         }
         other => {

@@ -23,7 +23,7 @@ use glam::Vec3;
 use rayon::prelude::*;
 
 use super::color::{rgb_to_xyz, xyz_to_lab, xyz_to_rgb, xyz_to_ycxcz, ycxcz_to_xyz};
-use super::image::{ErrorMap, LinearImage, same_size};
+use super::image::{ErrorMap, LinearImage, same_dims, same_size};
 use crate::error::Result;
 
 /// π in `f32` (the reference's literal 3.14159265358979f rounds to the same value).
@@ -301,12 +301,10 @@ impl Flip {
         reference: &FlipPrepared,
         test: &FlipPrepared,
     ) -> Result<FlipScore> {
-        if (reference.width, reference.height) != (test.width, test.height) {
-            return Err(crate::error::Error::Usage(format!(
-                "the images differ in size ({}x{} vs {}x{}); render or crop them to the same size",
-                reference.width, reference.height, test.width, test.height
-            )));
-        }
+        same_dims(
+            (reference.width, reference.height),
+            (test.width, test.height),
+        )?;
         let cmax = self.cmax;
         let pccmax = PC * cmax;
         let inv_sqrt2 = 1.0 / 2f32.sqrt();

@@ -100,10 +100,15 @@ pub struct ErrorMap {
 
 /// Check that two images can be compared.
 pub(crate) fn same_size(a: &LinearImage, b: &LinearImage) -> Result<()> {
-    if a.width != b.width || a.height != b.height {
+    same_dims((a.width, a.height), (b.width, b.height))
+}
+
+/// Check that two (width, height) pairs agree, with the message every metric gives.
+pub(crate) fn same_dims(a: (usize, usize), b: (usize, usize)) -> Result<()> {
+    if a != b {
         return Err(Error::Usage(format!(
             "the images differ in size ({}x{} vs {}x{}); render or crop them to the same size",
-            a.width, a.height, b.width, b.height
+            a.0, a.1, b.0, b.1
         )));
     }
     Ok(())

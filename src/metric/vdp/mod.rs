@@ -42,7 +42,7 @@ pub use psychometric::BETA;
 
 use self::bands::{Band, ORIENTATIONS, Plane};
 use super::csf::{ClampedCsf, daly_rushmeier};
-use super::image::{ErrorMap, LinearImage, same_size};
+use super::image::{ErrorMap, LinearImage, same_dims, same_size};
 use crate::error::Result;
 use crate::scene::Viewing;
 
@@ -148,12 +148,10 @@ impl Vdp {
         reference: &VdpPrepared,
         test: &VdpPrepared,
     ) -> Result<VdpScore> {
-        if (reference.width, reference.height) != (test.width, test.height) {
-            return Err(crate::error::Error::Usage(format!(
-                "the images differ in size ({}x{} vs {}x{}); render or crop them to the same size",
-                reference.width, reference.height, test.width, test.height
-            )));
-        }
+        same_dims(
+            (reference.width, reference.height),
+            (test.width, test.height),
+        )?;
         let (w, h) = (reference.width, reference.height);
         let beta = BETA;
         let mut pixel_sum = vec![0.0f64; w * h];
