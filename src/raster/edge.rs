@@ -90,53 +90,34 @@ pub(crate) fn rasterize(
         }
     }
     // The common sample counts get a loop the compiler can unroll (1 and 4 samples).
+    let edges = Edges { origin, coef, bias };
+    let rect = [x0, y0, x1, y1];
     match s {
-        1 => scan::<1>(
-            st,
-            id,
-            [x0, y0, x1, y1],
-            origin,
-            coef,
-            bias,
-            sample_off,
-            buf,
-        ),
-        4 => scan::<4>(
-            st,
-            id,
-            [x0, y0, x1, y1],
-            origin,
-            coef,
-            bias,
-            sample_off,
-            buf,
-        ),
-        _ => scan::<0>(
-            st,
-            id,
-            [x0, y0, x1, y1],
-            origin,
-            coef,
-            bias,
-            sample_off,
-            buf,
-        ),
+        1 => scan::<1>(st, id, rect, &edges, sample_off, buf),
+        4 => scan::<4>(st, id, rect, &edges, sample_off, buf),
+        _ => scan::<0>(st, id, rect, &edges, sample_off, buf),
     }
 }
 
+/// A triangle's three edge functions: value at the clip rectangle's first pixel corner, the
+/// coefficients of x and y, and the top-left bias.
+struct Edges {
+    origin: [i64; 3],
+    coef: [[i64; 2]; 3],
+    bias: [i64; 3],
+}
+
 /// The pixel loop of [`rasterize`]; `S` is the sample count, or 0 for "read it from the slice".
-#[allow(clippy::too_many_arguments)]
 #[inline(always)]
 fn scan<const S: usize>(
     st: &SetupTri,
     id: u32,
     [x0, y0, x1, y1]: [i32; 4],
-    origin: [i64; 3],
-    coef: [[i64; 2]; 3],
-    bias: [i64; 3],
+    edges: &Edges,
     sample_off: &[[i64; 3]],
     buf: &mut TileSamples,
 ) {
+    let Edges { origin, coef, bias } = *edges;
     let one = super::fixed::ONE_PIXEL;
     let s = if S == 0 { sample_off.len() } else { S };
     let sample_off = &sample_off[..s];
