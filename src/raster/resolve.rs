@@ -207,13 +207,15 @@ impl Pass {
             .into_par_iter()
             .map(|t| self.resolve(ctx, &self.raster_tile(t)))
             .collect();
+        // Every pixel is written below, so the buffers start as zeroed (calloc'd, untouched) pages
+        // rather than being filled with their "empty" values first.
         let mut frame = Frame {
             width: w as u32,
             height: h as u32,
             color: vec![Vec3::ZERO; n],
-            depth: vec![f32::INFINITY; n],
+            depth: vec![0.0; n],
             coverage: vec![0.0; n],
-            triangle: vec![NO_TRIANGLE; n],
+            triangle: vec![0; n],
         };
         let band = bin::TILE as usize * w;
         let tiles_x = (w as u32).div_ceil(bin::TILE) as usize;
