@@ -59,27 +59,63 @@ fn incidence(weld: &[u32], welded: usize, triangles: &[[u32; 3]]) -> Incidence {
     Incidence { start, corners }
 }
 
+/// Smooth angle-weighted normals (no creases), one per vertex; vertices sharing a position get
+/// the same normal.
+fn smooth(positions: &[Vec3], triangles: &[[u32; 3]]) -> Vec<Vec3> {
+    let n = Neighbourhoods::new(positions, triangles);
+    let (weld, welded, face_n, angles) = (&n.weld, n.welded, &n.face_n, &n.angles);
+    let around = |w: usize| n.around(w);
+    // One normal per welded position.
+    let per_welded: Vec<Vec3> = (0..welded)
+        .map(|w| {
+            let sum: Vec3 = around(w)
+                .iter()
+                .map(|&(t, k)| face_n[t as usize] * angles[t as usize][k as usize])
+                .sum();
+            sum.try_normalize().unwrap_or(Vec3::Z)
+        })
+        .collect();
+    weld.iter().map(|&w| per_welded[w as usize]).collect()
+}
+
+/// Welded positions, face frames and the corners around each welded position.
+struct Neighbourhoods {
+    weld: Vec<u32>,
+    welded: usize,
+    face_n: Vec<Vec3>,
+    angles: Vec<[f32; 3]>,
+    inc: Incidence,
+}
+
+impl Neighbourhoods {
+    fn new(positions: &[Vec3], triangles: &[[u32; 3]]) -> Neighbourhoods {
+        let (weld, welded) = weld::by_position(positions);
+        let (face_n, angles) = face_frames(positions, triangles);
+        let inc = incidence(&weld, welded, triangles);
+        Neighbourhoods {
+            weld,
+            welded,
+            face_n,
+            angles,
+            inc,
+        }
+    }
+
+    /// The (triangle, corner) pairs around welded position `w`.
+    fn around(&self, w: usize) -> &[(u32, u8)] {
+        &self.inc.corners[self.inc.start[w] as usize..self.inc.start[w + 1] as usize]
+    }
+}
+
 /// Compute normals for a mesh without them, splitting vertices along creases.
 /// Returns one unit normal per (possibly new) vertex; `data` gains the split vertices.
 pub(crate) fn generate(data: &mut MeshData, crease_angle_deg: f32) -> Vec<Vec3> {
-    let (weld, welded) = weld::by_position(&data.positions);
-    let (face_n, angles) = face_frames(&data.positions, &data.triangles);
-    let inc = incidence(&weld, welded, &data.triangles);
-    let around = |w: usize| &inc.corners[inc.start[w] as usize..inc.start[w + 1] as usize];
-
     if crease_angle_deg >= 180.0 {
-        // Smooth everywhere: one normal per welded position.
-        let per_welded: Vec<Vec3> = (0..welded)
-            .map(|w| {
-                let sum: Vec3 = around(w)
-                    .iter()
-                    .map(|&(t, k)| face_n[t as usize] * angles[t as usize][k as usize])
-                    .sum();
-                sum.try_normalize().unwrap_or(Vec3::Z)
-            })
-            .collect();
-        return weld.iter().map(|&w| per_welded[w as usize]).collect();
+        return smooth(&data.positions, &data.triangles);
     }
+    let n = Neighbourhoods::new(&data.positions, &data.triangles);
+    let (weld, face_n, angles) = (&n.weld, &n.face_n, &n.angles);
+    let around = |w: usize| n.around(w);
 
     // Creased: a normal per corner, then one vertex per distinct (vertex, normal) pair.
     let cos_crease = crease_angle_deg.to_radians().cos();
@@ -154,24 +190,7 @@ pub(crate) fn normalize_given(
         .map(|n| if unit(n) { Some(*n) } else { n.try_normalize() })
         .collect();
     if out.iter().any(Option::is_none) {
-        let mut tmp = MeshData {
-            positions: positions.to_vec(),
-            normals: None,
-            uvs: None,
-            colors: None,
-            triangles: triangles.to_vec(),
-            material_ids: vec![],
-            materials: vec![],
-            source: super::Source {
-                path: Default::default(),
-                format: super::Format::Obj,
-                file_vertices: 0,
-                file_faces: 0,
-                file_unreferenced: 0,
-            },
-            warnings: vec![],
-        };
-        let computed = generate(&mut tmp, 180.0);
+        let computed = smooth(positions, triangles);
         for (o, c) in out.iter_mut().zip(computed) {
             o.get_or_insert(c);
         }
