@@ -19,6 +19,11 @@ pub fn srgb_to_linear(c: f32) -> f32 {
     }
 }
 
+/// Linear light of every 8-bit sRGB code value (index = byte).
+pub fn srgb8_to_linear_table() -> [f32; 256] {
+    std::array::from_fn(|i| srgb_to_linear(i as f32 / 255.0))
+}
+
 /// Linear light in 0..1 → sRGB-encoded value.
 pub fn linear_to_srgb(c: f32) -> f32 {
     if c <= 0.003_130_8 {

@@ -4,7 +4,7 @@
 use glam::Vec3;
 
 use crate::error::{Error, Result};
-use crate::metric::color::srgb_to_linear;
+use crate::metric::color::srgb8_to_linear_table;
 
 /// A linear-light RGB image.
 ///
@@ -29,7 +29,7 @@ impl LinearImage {
 
     /// Decode 8-bit sRGB RGB bytes (row-major) to linear light.
     pub fn from_srgb8(width: usize, height: usize, rgb: &[u8]) -> Option<LinearImage> {
-        let lut: Vec<f32> = (0..256).map(|i| srgb_to_linear(i as f32 / 255.0)).collect();
+        let lut = srgb8_to_linear_table();
         let pixels = rgb
             .chunks_exact(3)
             .map(|c| Vec3::new(lut[c[0] as usize], lut[c[1] as usize], lut[c[2] as usize]))

@@ -12,7 +12,7 @@
 use glam::{Vec2, Vec3};
 
 use crate::mesh::{ColorSpace, Texture};
-use crate::metric::color::srgb_to_linear;
+use crate::metric::color::srgb8_to_linear_table;
 
 /// One level of the pyramid.
 #[derive(Debug, Clone)]
@@ -31,12 +31,10 @@ pub struct MipTexture {
 impl MipTexture {
     /// Build the pyramid for a decoded texture.
     pub fn build(texture: &Texture) -> MipTexture {
-        let table: Vec<f32> = (0..256)
-            .map(|i| match texture.color_space() {
-                ColorSpace::Srgb => srgb_to_linear(i as f32 / 255.0),
-                ColorSpace::Linear => i as f32 / 255.0,
-            })
-            .collect();
+        let table: [f32; 256] = match texture.color_space() {
+            ColorSpace::Srgb => srgb8_to_linear_table(),
+            ColorSpace::Linear => std::array::from_fn(|i| i as f32 / 255.0),
+        };
         let texels = texture
             .rgba()
             .chunks_exact(4)
