@@ -277,6 +277,12 @@ impl LoadArgs {
     }
 }
 
+/// Write a value to stdout as pretty JSON with a trailing newline.
+fn emit_json<T: serde::Serialize>(value: &T) -> Result<(), Error> {
+    let json = serde_json::to_string_pretty(value).map_err(|e| Error::Internal(e.to_string()))?;
+    emit(&(json + "\n"))
+}
+
 /// Write to stdout; a closed pipe (e.g. `| head`) is not an error.
 fn emit(text: &str) -> Result<(), Error> {
     let mut out = std::io::stdout().lock();
@@ -303,9 +309,7 @@ fn run(cli: Cli) -> Result<(), Error> {
             let mesh = lodeval::mesh::load(&a.mesh, &a.load.options()?)?;
             let summary = MeshSummary::of(&mesh);
             if a.json {
-                let json = serde_json::to_string_pretty(&summary)
-                    .map_err(|e| Error::Internal(e.to_string()))?;
-                emit(&(json + "\n"))
+                emit_json(&summary)
             } else {
                 emit(&summary.to_string())
             }
@@ -368,11 +372,7 @@ fn run(cli: Cli) -> Result<(), Error> {
                 lenient,
             )?;
             if a.json {
-                emit(
-                    &(serde_json::to_string_pretty(&results)
-                        .map_err(|e| Error::Internal(e.to_string()))?
-                        + "\n"),
-                )
+                emit_json(&results)
             } else {
                 let mut text = String::new();
                 for r in &results {
@@ -411,9 +411,7 @@ fn run(cli: Cli) -> Result<(), Error> {
                     ));
                 };
                 let rows = lodeval::commands::bench_metrics(reference, test, a.runs)?;
-                let json = serde_json::to_string_pretty(&rows)
-                    .map_err(|e| Error::Internal(e.to_string()))?;
-                return emit(&(json + "\n"));
+                return emit_json(&rows);
             }
             if a.what != "raster" {
                 return Err(Error::Usage(format!(
@@ -444,13 +442,13 @@ fn run(cli: Cli) -> Result<(), Error> {
             };
             let rows = lodeval::commands::bench_raster(&job)?;
             let rss = lodeval::commands::peak_rss_mib().unwrap_or(f64::NAN);
-            let text = if a.json {
-                serde_json::to_string_pretty(&rows).map_err(|e| Error::Internal(e.to_string()))?
-                    + "\n"
-            } else {
-                lodeval::commands::raster_bench_table(&rows) + &format!("peak RSS: {rss:.0} MiB\n")
-            };
-            emit(&text)
+            if a.json {
+                return emit_json(&rows);
+            }
+            emit(
+                &(lodeval::commands::raster_bench_table(&rows)
+                    + &format!("peak RSS: {rss:.0} MiB\n")),
+            )
         }
         other => {
             let name = format!("{other:?}")
