@@ -24,11 +24,13 @@
 
 pub mod commands;
 pub mod error;
+pub mod eval;
 pub mod io;
 pub mod mesh;
 pub mod metric;
 pub mod raster;
 pub mod scene;
+pub mod simplify;
 
 pub use error::{Error, Location, Result};
 pub use mesh::{LoadOptions, Mesh, MeshSummary, MissingAssets};

@@ -37,18 +37,18 @@ enum Command {
     Render(RenderArgs),
     /// Compare two images with the perceptual metrics.
     Diff(DiffArgs),
-    /// Run a batch evaluation config (not built yet).
-    Eval(NotYet),
-    /// Compare renders with golden images, or bless new ones (not built yet).
-    Golden(NotYet),
+    /// Run a batch evaluation config: render, score, write CSVs, heat maps, report; gate.
+    Eval(EvalArgs),
+    /// Compare renders with golden images, or bless new ones.
+    Golden(GoldenArgs),
     /// Simplify a mesh (not built yet).
     Simplify(NotYet),
     /// Image-driven optimisation of a simplified mesh (not built yet).
     Optimize(NotYet),
     /// Run a benchmark (`raster`) and print its table.
     Bench(BenchArgs),
-    /// Merge the outputs of sharded runs (not built yet).
-    Merge(NotYet),
+    /// Merge the outputs of sharded runs into what one machine would have written.
+    Merge(MergeArgs),
 }
 
 #[derive(Args, Debug)]
@@ -252,6 +252,41 @@ enum MissingArg {
     Warn,
 }
 
+#[derive(Args, Debug)]
+struct EvalArgs {
+    /// The batch config (TOML; see configs/README.md).
+    config: PathBuf,
+    /// Output folder (default: the config's `out`, else ../results/<config name> beside it).
+    #[arg(long, value_name = "DIR")]
+    out: Option<PathBuf>,
+    /// Run one shard: INDEX/COUNT, 0-based (also from TEST_SHARD_INDEX/TEST_TOTAL_SHARDS,
+    /// CI_NODE_INDEX/CI_NODE_TOTAL, JOB_COMPLETION_INDEX with LODEVAL_SHARD_COUNT).
+    #[arg(long, value_name = "INDEX/COUNT")]
+    shard: Option<String>,
+}
+
+#[derive(Args, Debug)]
+struct GoldenArgs {
+    /// The batch config whose renders are checked.
+    config: PathBuf,
+    /// Write the current renders as the new goldens (refused when CI is set).
+    #[arg(long)]
+    bless: bool,
+    /// Where actual and diff images of mismatches go (default: the config's output folder).
+    #[arg(long, value_name = "DIR")]
+    out: Option<PathBuf>,
+}
+
+#[derive(Args, Debug)]
+struct MergeArgs {
+    /// Output folders of the shard runs.
+    #[arg(required = true)]
+    shards: Vec<PathBuf>,
+    /// The merged output folder.
+    #[arg(long, value_name = "DIR")]
+    out: PathBuf,
+}
+
 /// Arguments of a subcommand that is not built yet, accepted so the message is about that.
 #[derive(Args, Debug)]
 struct NotYet {
@@ -450,6 +485,56 @@ fn run(cli: Cli) -> Result<(), Error> {
                     + &format!("peak RSS: {rss:.0} MiB\n")),
             )
         }
+        Command::Eval(a) => {
+            use std::io::IsTerminal;
+            let shard = match &a.shard {
+                Some(s) => lodeval::eval::Shard::parse(s)?,
+                None => lodeval::eval::Shard::from_env(|k| std::env::var(k).ok())?
+                    .unwrap_or(lodeval::eval::Shard::ALL),
+            };
+            let options = lodeval::eval::RunOptions {
+                out: a.out,
+                shard,
+                progress: !cli.quiet && std::io::stderr().is_terminal(),
+            };
+            let outcome = lodeval::eval::eval(&a.config, &options)?;
+            gate_result(&outcome)
+        }
+        Command::Merge(a) => {
+            let outcome = lodeval::eval::merge(&a.shards, &a.out)?;
+            gate_result(&outcome)
+        }
+        Command::Golden(a) => {
+            let plan = lodeval::eval::Plan::load(&a.config)?;
+            let out = plan.config.out_dir(&plan.config_path, a.out.as_deref());
+            let ci = std::env::var_os("CI").is_some_and(|v| !v.is_empty());
+            let g = lodeval::eval::golden::run(&plan, a.bless, ci, &out)?;
+            let dir = lodeval::eval::golden::golden_dir(&plan);
+            if a.bless {
+                return emit(&format!(
+                    "blessed {} golden image(s) in {}\n",
+                    g.checked,
+                    dir.display()
+                ));
+            }
+            for m in &g.mismatches {
+                eprintln!("{m}");
+            }
+            if g.mismatches.is_empty() {
+                emit(&format!(
+                    "{} image(s) match their goldens in {}\n",
+                    g.checked,
+                    dir.display()
+                ))
+            } else {
+                Err(Error::Regression(format!(
+                    "{} of {} image(s) differ from their goldens; if the change is intended, run: lodeval golden {} --bless",
+                    g.mismatches.len(),
+                    g.checked,
+                    a.config.display()
+                )))
+            }
+        }
         other => {
             let name = format!("{other:?}")
                 .split('(')
@@ -460,6 +545,24 @@ fn run(cli: Cli) -> Result<(), Error> {
                 "`lodeval {name}` is not built yet; this build can run `lodeval info`"
             )))
         }
+    }
+}
+
+/// Print an eval or merge outcome: the summary table on stdout, failures on stderr, exit 1 on
+/// failure.
+fn gate_result(outcome: &lodeval::eval::Outcome) -> Result<(), Error> {
+    emit(&lodeval::eval::summary_table(outcome))?;
+    for f in &outcome.failures {
+        eprintln!("{}", f.message);
+    }
+    if outcome.failures.is_empty() {
+        emit(&format!("wrote {}\n", outcome.out_dir.display()))
+    } else {
+        Err(Error::Regression(format!(
+            "{} gate check(s) failed; details in {}",
+            outcome.failures.len(),
+            outcome.out_dir.join("report.html").display()
+        )))
     }
 }
 

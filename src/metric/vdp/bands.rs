@@ -125,7 +125,7 @@ pub(crate) fn decompose(p: &Plane, max_levels: usize) -> Vec<Band> {
 
 /// cos²-tuned orientation weights from the local gradient direction (central differences),
 /// halved so the four weights sum to 1. Flat samples (no gradient) spread evenly.
-fn orientation_weights(p: &Plane) -> Vec<[f32; ORIENTATIONS]> {
+pub(crate) fn orientation_weights(p: &Plane) -> Vec<[f32; ORIENTATIONS]> {
     (0..p.w * p.h)
         .into_par_iter()
         .map(|i| {

@@ -1,0 +1,772 @@
+//! The batch configuration: a TOML file parsed with serde (`deny_unknown_fields` everywhere), its
+//! defaults (DESIGN.md, documented key by key in `configs/README.md`), and the checks that turn a
+//! bad key or value into one exit-2 message naming the key, the file and the line.
+//!
+//! Decisions:
+//! - Paths inside a config (meshes, baseline, goldens, `out`) are relative to the config file's
+//!   folder, so a config means the same thing whatever the working directory. `--out` on the
+//!   command line is relative to the working directory, as command-line paths are.
+//! - Values are checked while deserializing (newtypes with `TryFrom`), so the TOML parser reports
+//!   the span of the offending value and the message can give its line.
+//! - Thresholds are layered global → asset → LOD field by field; each resolved threshold remembers
+//!   which layer it came from, so a gate failure can say where its limit was set.
+
+use std::path::{Path, PathBuf};
+
+use serde::Deserialize;
+
+use crate::error::{Error, Location, Result};
+use crate::raster::{RenderSettings, SamplePattern, Shading};
+use crate::scene::{Light, Rig, Viewing};
+
+/// A whole config file.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Config {
+    /// Output folder, relative to the config file. Default value: `../results/<config file stem>`.
+    pub out: Option<PathBuf>,
+    /// Render settings.
+    #[serde(default)]
+    pub render: RenderConfig,
+    /// Viewing conditions.
+    #[serde(default)]
+    pub viewing: ViewingConfig,
+    /// Metric families to compute. Default value: `["flip", "ssim", "psnr", "vdp"]`.
+    #[serde(default = "default_metrics")]
+    pub metrics: Vec<MetricFamily>,
+    /// FLIP per-pixel level above which a pixel counts as "different" for `flip_share`. Default 0.1.
+    #[serde(default = "default_flip_pixel")]
+    pub flip_pixel_threshold: UnitInterval,
+    /// Output images.
+    #[serde(default)]
+    pub images: ImagesConfig,
+    /// Imperceptibility distances.
+    #[serde(default)]
+    pub distance: DistanceConfig,
+    /// Global thresholds (the first layer).
+    #[serde(default)]
+    pub thresholds: Thresholds,
+    /// Baseline comparison.
+    #[serde(default)]
+    pub gate: GateConfig,
+    /// Golden-image comparison (`lodeval golden`).
+    #[serde(default)]
+    pub golden: GoldenConfig,
+    /// The assets.
+    #[serde(rename = "asset")]
+    pub assets: Vec<AssetConfig>,
+}
+
+fn default_metrics() -> Vec<MetricFamily> {
+    vec![
+        MetricFamily::Flip,
+        MetricFamily::Ssim,
+        MetricFamily::Psnr,
+        MetricFamily::Vdp,
+    ]
+}
+
+fn default_flip_pixel() -> UnitInterval {
+    UnitInterval(0.1)
+}
+
+/// `[render]`.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct RenderConfig {
+    /// Square image edge in pixels (1..=16384). Default value: 512.
+    pub size: ImageSize,
+    /// Samples per pixel: 1, 4, 9, …, 64. Default value: 4.
+    pub samples: SampleCount,
+    /// `rotated` or `ordered`. Default value: `rotated`.
+    pub pattern: PatternName,
+    /// `dodecahedron`, `icosahedron` or `fibonacci:N`. Default value: `dodecahedron` (20 views).
+    pub rig: RigName,
+    /// Shading model name. Default value: `gouraud`.
+    pub shading: ShadingName,
+    /// Skip back faces. Default value: false (flipped LOD triangles must show).
+    pub cull_backfaces: bool,
+    /// Background colour, sRGB in [0, 1]. Default value: [0.5, 0.5, 0.5].
+    pub background: [UnitInterval; 3],
+    /// Ambient term. Default value: 0.15.
+    pub ambient: UnitInterval,
+    /// Lights. Default value: one headlight.
+    pub lights: Vec<LightConfig>,
+}
+
+impl Default for RenderConfig {
+    fn default() -> Self {
+        RenderConfig {
+            size: ImageSize(512),
+            samples: SampleCount(4),
+            pattern: PatternName::Rotated,
+            rig: RigName(Rig::Dodecahedron),
+            shading: ShadingName(Shading::Gouraud),
+            cull_backfaces: false,
+            background: [UnitInterval(0.5); 3],
+            ambient: UnitInterval(0.15),
+            lights: vec![LightConfig::Headlight { intensity: None }],
+        }
+    }
+}
+
+impl RenderConfig {
+    /// The rasterizer settings this section describes.
+    pub fn settings(&self) -> RenderSettings {
+        let mut s = RenderSettings::DEFAULT;
+        s.width = self.size.0;
+        s.height = self.size.0;
+        let n = (self.samples.0 as f64).sqrt().round() as u32;
+        s.samples = match self.pattern {
+            PatternName::Rotated => SamplePattern::Rotated(n),
+            PatternName::Ordered => SamplePattern::Ordered(n),
+        };
+        s.shading = self.shading.0;
+        s.cull_backfaces = self.cull_backfaces;
+        s
+    }
+
+    /// The scene lights.
+    pub fn scene_lights(&self) -> Vec<Light> {
+        self.lights.iter().map(LightConfig::light).collect()
+    }
+}
+
+/// One `[[render.lights]]` entry.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields, tag = "kind", rename_all = "lowercase")]
+pub enum LightConfig {
+    /// The camera-following light (DESIGN.md default).
+    Headlight {
+        /// Grey intensity. Default value: 0.85.
+        intensity: Option<UnitInterval>,
+    },
+    /// A fixed world-space light.
+    Directional {
+        /// Towards the light, world space (normalised).
+        direction: [f32; 3],
+        /// Grey intensity. Default value: 0.85.
+        intensity: Option<UnitInterval>,
+    },
+}
+
+impl LightConfig {
+    fn light(&self) -> Light {
+        let grey = |i: &Option<UnitInterval>| glam::Vec3::splat(i.map_or(0.85, |v| v.0 as f32));
+        match self {
+            LightConfig::Headlight { intensity } => Light::Headlight {
+                offset: crate::scene::HEADLIGHT_OFFSET,
+                color: grey(intensity),
+            },
+            LightConfig::Directional {
+                direction,
+                intensity,
+            } => Light::Directional {
+                direction: glam::Vec3::from_array(*direction),
+                color: grey(intensity),
+            },
+        }
+    }
+}
+
+/// `[viewing]`: the display and the viewer.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct ViewingConfig {
+    /// Display width in metres. Default value: 0.7.
+    pub display_width_m: Positive,
+    /// Display width in pixels. Default value: 3840.
+    pub display_px: Positive,
+    /// Display height in pixels (for engine screen-size parameters). Default value: 2160.
+    pub display_height_px: Positive,
+    /// Viewer distance to the display in metres. Default value: 0.7.
+    pub distance_m: Positive,
+    /// Pixels per degree, overriding the display geometry for the metrics. Default: derived.
+    pub ppd: Option<Positive>,
+}
+
+impl Default for ViewingConfig {
+    fn default() -> Self {
+        ViewingConfig {
+            display_width_m: Positive(0.7),
+            display_px: Positive(3840.0),
+            display_height_px: Positive(2160.0),
+            distance_m: Positive(0.7),
+            ppd: None,
+        }
+    }
+}
+
+impl ViewingConfig {
+    /// The metric stack's viewing conditions.
+    pub fn viewing(&self) -> Viewing {
+        match self.ppd {
+            Some(p) => Viewing::from_ppd(p.0),
+            None => {
+                Viewing::from_display(self.display_width_m.0, self.display_px.0, self.distance_m.0)
+            }
+        }
+    }
+}
+
+/// `[images]`: which pictures `eval` writes.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct ImagesConfig {
+    /// Heat maps per asset/LOD/view/metric: `all`, `worst` (worst view per LOD) or `none`.
+    /// Default value: `all`.
+    pub heatmaps: HeatmapChoice,
+    /// One contact sheet per LOD (original | LOD | heat map, worst views first). Default: true.
+    pub contact_sheets: bool,
+    /// Views per contact sheet, worst first. Default value: 6.
+    pub sheet_views: usize,
+}
+
+impl Default for ImagesConfig {
+    fn default() -> Self {
+        ImagesConfig {
+            heatmaps: HeatmapChoice::All,
+            contact_sheets: true,
+            sheet_views: 6,
+        }
+    }
+}
+
+/// See [`ImagesConfig::heatmaps`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum HeatmapChoice {
+    /// Every view.
+    All,
+    /// Only each LOD's worst view.
+    Worst,
+    /// None.
+    None,
+}
+
+/// `[distance]`: the imperceptibility distance search (`eval/distance.rs`).
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct DistanceConfig {
+    /// Compute distances. Default value: true.
+    pub enabled: bool,
+    /// VDP detection probability at or below which a LOD counts as imperceptible. Default: 0.5.
+    pub probability: UnitInterval,
+    /// Also report FLIP's distance: the nearest distance beyond which the worst view's FLIP mean
+    /// stays at or below this value. Default value: 0.01.
+    pub flip_mean: Option<UnitInterval>,
+    /// Samples per pixel for the small renders. Default value: 16.
+    pub samples: SampleCount,
+    /// Largest on-screen object diameter searched, pixels; a LOD still visible there is reported
+    /// as visible at every distance down to it. Default value: 512.
+    pub max_diameter_px: ImageSize,
+    /// Views of the rig used (the first N in the rig's numbering). Default value: all.
+    pub views: Option<usize>,
+}
+
+impl Default for DistanceConfig {
+    fn default() -> Self {
+        DistanceConfig {
+            enabled: true,
+            probability: UnitInterval(0.5),
+            flip_mean: Some(UnitInterval(0.01)),
+            samples: SampleCount(16),
+            max_diameter_px: ImageSize(512),
+            views: None,
+        }
+    }
+}
+
+/// Limits on a LOD's scores. Every field is optional; unset fields inherit from the layer above.
+#[derive(Debug, Clone, Default, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct Thresholds {
+    /// Largest allowed FLIP mean, averaged over views.
+    pub flip_mean: Option<f64>,
+    /// Largest allowed FLIP mean of the worst view.
+    pub flip_worst_view: Option<f64>,
+    /// Largest allowed per-pixel 95th-percentile FLIP, worst view.
+    pub flip_p95: Option<f64>,
+    /// Largest allowed share of pixels with FLIP above `flip_pixel_threshold`, worst view.
+    pub flip_share: Option<f64>,
+    /// Largest allowed VDP detection probability, worst view.
+    pub vdp_probability: Option<f64>,
+    /// Smallest allowed PSNR in dB, worst view.
+    pub psnr_min: Option<f64>,
+    /// Smallest allowed SSIM, worst view.
+    pub ssim_min: Option<f64>,
+    /// Smallest allowed MS-SSIM, worst view.
+    pub msssim_min: Option<f64>,
+}
+
+impl Thresholds {
+    /// Every threshold as (name, value), in a fixed order.
+    pub fn entries(&self) -> [(&'static str, Option<f64>); 8] {
+        [
+            ("flip_mean", self.flip_mean),
+            ("flip_worst_view", self.flip_worst_view),
+            ("flip_p95", self.flip_p95),
+            ("flip_share", self.flip_share),
+            ("vdp_probability", self.vdp_probability),
+            ("psnr_min", self.psnr_min),
+            ("ssim_min", self.ssim_min),
+            ("msssim_min", self.msssim_min),
+        ]
+    }
+}
+
+/// `[gate]`: comparison with a baseline run.
+#[derive(Debug, Clone, Default, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct GateConfig {
+    /// A `summary.csv` from an accepted run. Default: none.
+    pub baseline: Option<PathBuf>,
+    /// Relative tolerance: a LOD regresses when a summary mean is worse than the baseline's by
+    /// more than this fraction (and by more than `absolute`). Default value: 0.1.
+    pub tolerance: Option<f64>,
+    /// Absolute slack added to the tolerance (ignores noise near zero). Default value: 1e-4.
+    pub absolute: Option<f64>,
+}
+
+/// `[golden]`: golden-image checks.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct GoldenConfig {
+    /// Folder of golden PNGs, `ASSET/LOD/view-NN.png`. Default value: `../reference/golden/<stem>`.
+    pub dir: Option<PathBuf>,
+    /// Largest FLIP mean between a render and its golden. Default value: 0.005.
+    pub flip_mean: UnitInterval,
+    /// Largest per-pixel 99th-percentile FLIP. Default value: 0.05.
+    pub flip_p99: UnitInterval,
+    /// Also check the LODs, not only the originals. Default value: true.
+    pub lods: bool,
+}
+
+impl Default for GoldenConfig {
+    fn default() -> Self {
+        GoldenConfig {
+            dir: None,
+            flip_mean: UnitInterval(0.005),
+            flip_p99: UnitInterval(0.05),
+            lods: true,
+        }
+    }
+}
+
+/// One `[[asset]]`.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct AssetConfig {
+    /// Name used in outputs (letters, digits, `-`, `_`, `.`).
+    pub name: Name,
+    /// The original mesh.
+    pub mesh: PathBuf,
+    /// Metres per model unit. Default value: 1.
+    #[serde(default = "one")]
+    pub meters_per_unit: Positive,
+    /// LOD files.
+    #[serde(default)]
+    pub lods: Vec<LodConfig>,
+    /// A LOD generator.
+    pub generate: Option<GenerateConfig>,
+    /// Asset-level thresholds (second layer).
+    #[serde(default)]
+    pub thresholds: Thresholds,
+}
+
+fn one() -> Positive {
+    Positive(1.0)
+}
+
+/// One LOD file of an asset.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LodConfig {
+    /// Name used in outputs. Default value: `lodN` (1-based position in the list).
+    pub name: Option<Name>,
+    /// The LOD mesh.
+    pub mesh: PathBuf,
+    /// The engine's current switch distance for this LOD, metres: the gate fails when the LOD is
+    /// still visible beyond it.
+    pub switch_m: Option<Positive>,
+    /// LOD-level thresholds (third layer).
+    #[serde(default)]
+    pub thresholds: Thresholds,
+}
+
+/// A LOD generator.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct GenerateConfig {
+    /// `meshopt` (meshoptimizer's `simplify`, the industrial baseline).
+    pub method: Method,
+    /// Target triangle ratios of the original, each LOD simplified from the previous one.
+    #[serde(default)]
+    pub ratios: Vec<UnitInterval>,
+    /// Target errors (meshoptimizer's relative error), as further LODs of the chain.
+    #[serde(default)]
+    pub errors: Vec<UnitInterval>,
+    /// Engine switch distances for the generated LODs, metres, in chain order.
+    #[serde(default)]
+    pub switch_m: Vec<Positive>,
+}
+
+/// Simplifiers a generator may name.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Method {
+    /// meshoptimizer (`meshopt` crate).
+    Meshopt,
+}
+
+/// Metric families; each writes one or more `metric` values into `metrics.csv`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum MetricFamily {
+    /// `flip` (mean), `flip_p95`, `flip_share`.
+    Flip,
+    /// `ssim`.
+    Ssim,
+    /// `msssim` (images ≥ 176 px per side).
+    Msssim,
+    /// `psnr` and `mse` (luminance).
+    Psnr,
+    /// `vdp` (detection probability) and `vdp_jnd`.
+    Vdp,
+}
+
+macro_rules! checked_newtype {
+    ($(#[$m:meta])* $name:ident($inner:ty), $from:literal, |$v:ident| $check:expr, $why:expr) => {
+        $(#[$m])*
+        #[derive(Debug, Clone, Copy, PartialEq, PartialOrd, Deserialize)]
+        #[serde(try_from = $from)]
+        pub struct $name(pub $inner);
+        impl TryFrom<$inner> for $name {
+            type Error = String;
+            fn try_from($v: $inner) -> std::result::Result<Self, String> {
+                if $check { Ok($name($v)) } else { Err(format!("{} is out of range: {}", $v, $why)) }
+            }
+        }
+    };
+}
+
+checked_newtype!(
+    /// A number in [0, 1].
+    UnitInterval(f64), "f64", |v| (0.0..=1.0).contains(&v), "use a value between 0 and 1"
+);
+checked_newtype!(
+    /// A finite number > 0.
+    Positive(f64), "f64", |v| v.is_finite() && v > 0.0, "use a finite number above 0"
+);
+checked_newtype!(
+    /// An image edge in pixels.
+    ImageSize(u32), "u32", |v| (1..=RenderSettings::MAX_SIZE).contains(&v),
+    "use 1 to 16384 pixels"
+);
+checked_newtype!(
+    /// Samples per pixel, a square n² with 1 ≤ n ≤ 8.
+    SampleCount(u32), "u32", |v| (1..=8u32).any(|n| n * n == v),
+    "use 1, 4, 9, 16, 25, 36, 49 or 64 samples per pixel"
+);
+
+/// Supersampling pattern names.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum PatternName {
+    /// Rotated grid.
+    Rotated,
+    /// Ordered grid.
+    Ordered,
+}
+
+/// A view rig by name.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(try_from = "String")]
+pub struct RigName(pub Rig);
+impl TryFrom<String> for RigName {
+    type Error = String;
+    fn try_from(s: String) -> std::result::Result<Self, String> {
+        Rig::parse(&s).map(RigName).ok_or_else(|| {
+            format!("unknown rig '{s}': use dodecahedron, icosahedron or fibonacci:N")
+        })
+    }
+}
+
+/// A shading model by name.
+#[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
+#[serde(try_from = "String")]
+pub struct ShadingName(pub Shading);
+impl TryFrom<String> for ShadingName {
+    type Error = String;
+    fn try_from(s: String) -> std::result::Result<Self, String> {
+        Shading::parse(&s).map(ShadingName).ok_or_else(|| {
+            let names: Vec<_> = Shading::ALL.iter().map(|s| s.name()).collect();
+            format!("unknown shading '{s}': use one of {}", names.join(", "))
+        })
+    }
+}
+
+/// An asset or LOD name: safe as a folder name and a CSV field.
+#[derive(Debug, Clone, PartialEq, Eq, PartialOrd, Ord, Deserialize)]
+#[serde(try_from = "String")]
+pub struct Name(pub String);
+impl TryFrom<String> for Name {
+    type Error = String;
+    fn try_from(s: String) -> std::result::Result<Self, String> {
+        let ok = !s.is_empty()
+            && s != "."
+            && s != ".."
+            && s.chars()
+                .all(|c| c.is_ascii_alphanumeric() || matches!(c, '-' | '_' | '.'));
+        if ok {
+            Ok(Name(s))
+        } else {
+            Err(format!(
+                "name '{s}' may only use letters, digits, '-', '_' and '.'"
+            ))
+        }
+    }
+}
+
+impl Config {
+    /// Parse a config from its text; `path` is only used in messages.
+    pub fn parse(text: &str, path: &Path) -> Result<Config> {
+        let config: Config = toml::from_str(text).map_err(|e| {
+            let line = e
+                .span()
+                .map(|s| text[..s.start.min(text.len())].matches('\n').count() + 1);
+            let problem = e.message().trim().to_string();
+            let fix = "see configs/README.md for every key, its type and its default";
+            match line {
+                Some(l) => Error::input_at(path, Location::Line(l), problem, fix),
+                None => Error::input(path, problem, fix),
+            }
+        })?;
+        config.check(text, path)?;
+        Ok(config)
+    }
+
+    /// Cross-field checks that serde cannot express.
+    fn check(&self, text: &str, path: &Path) -> Result<()> {
+        let at = |needle: &str| {
+            text.find(needle)
+                .map(|i| Location::Line(text[..i].matches('\n').count() + 1))
+        };
+        let fail = |needle: &str, problem: String, fix: &str| match at(needle) {
+            Some(l) => Error::input_at(path, l, problem, fix),
+            None => Error::input(path, problem, fix),
+        };
+        if self.assets.is_empty() {
+            return Err(Error::input(
+                path,
+                "has no [[asset]] entries",
+                "add at least one [[asset]] with a name and a mesh",
+            ));
+        }
+        if self.metrics.is_empty() {
+            return Err(fail(
+                "metrics",
+                "metrics is empty".into(),
+                "list at least one of flip, ssim, msssim, psnr, vdp",
+            ));
+        }
+        let mut names = std::collections::BTreeSet::new();
+        for a in &self.assets {
+            let quoted = format!("\"{}\"", a.name.0);
+            if !names.insert(a.name.0.clone()) {
+                return Err(fail(
+                    &quoted,
+                    format!("asset name '{}' is used twice", a.name.0),
+                    "give every [[asset]] its own name",
+                ));
+            }
+            if a.lods.is_empty() && a.generate.is_none() {
+                return Err(fail(
+                    &quoted,
+                    format!("asset '{}' has neither lods nor generate", a.name.0),
+                    "list LOD files in `lods` or add `generate = { method = \"meshopt\", ratios = [...] }`",
+                ));
+            }
+            if let Some(g) = &a.generate
+                && g.ratios.is_empty()
+                && g.errors.is_empty()
+            {
+                return Err(fail(
+                    &quoted,
+                    format!("asset '{}': generate has no ratios and no errors", a.name.0),
+                    "give `ratios = [0.5, 0.25]` and/or `errors = [0.01]`",
+                ));
+            }
+            let mut lod_names = std::collections::BTreeSet::new();
+            for (name, _) in self.lod_names(a) {
+                if !lod_names.insert(name.clone()) {
+                    return Err(fail(
+                        &quoted,
+                        format!("asset '{}': LOD name '{name}' is used twice", a.name.0),
+                        "give every LOD its own name",
+                    ));
+                }
+            }
+            for t in [&a.thresholds]
+                .into_iter()
+                .chain(a.lods.iter().map(|l| &l.thresholds))
+            {
+                check_thresholds(t).map_err(|why| fail(&quoted, why, THRESHOLD_FIX))?;
+            }
+        }
+        check_thresholds(&self.thresholds)
+            .map_err(|why| fail("[thresholds]", why, THRESHOLD_FIX))?;
+        if let Some(t) = self.gate.tolerance
+            && !(t.is_finite() && t >= 0.0)
+        {
+            return Err(fail(
+                "tolerance",
+                format!("gate.tolerance {t} must be a finite number ≥ 0"),
+                "use e.g. 0.1 for 10 %",
+            ));
+        }
+        Ok(())
+    }
+
+    /// Every LOD of an asset as (name, index in the chain), files first then generated.
+    pub fn lod_names(&self, asset: &AssetConfig) -> Vec<(String, usize)> {
+        let mut out: Vec<(String, usize)> = asset
+            .lods
+            .iter()
+            .enumerate()
+            .map(|(i, l)| {
+                (
+                    l.name
+                        .as_ref()
+                        .map_or_else(|| format!("lod{}", i + 1), |n| n.0.clone()),
+                    i,
+                )
+            })
+            .collect();
+        if let Some(g) = &asset.generate {
+            let base = out.len();
+            for (k, r) in g.ratios.iter().enumerate() {
+                out.push((format!("meshopt-r{}", percent_label(r.0)), base + k));
+            }
+            for (k, e) in g.errors.iter().enumerate() {
+                out.push((format!("meshopt-e{}", e.0), base + g.ratios.len() + k));
+            }
+        }
+        out
+    }
+
+    /// The output folder: `override_out` if given, else `out` relative to the config, else
+    /// `../results/<stem>` relative to the config.
+    pub fn out_dir(&self, config_path: &Path, override_out: Option<&Path>) -> PathBuf {
+        if let Some(o) = override_out {
+            return o.to_path_buf();
+        }
+        let base = config_dir(config_path);
+        match &self.out {
+            Some(o) => base.join(o),
+            None => base.join("..").join("results").join(stem(config_path)),
+        }
+    }
+}
+
+const THRESHOLD_FIX: &str =
+    "thresholds are finite numbers (FLIP, shares and probabilities between 0 and 1)";
+
+fn check_thresholds(t: &Thresholds) -> std::result::Result<(), String> {
+    for (name, v) in t.entries() {
+        let Some(v) = v else { continue };
+        let unit = matches!(
+            name,
+            "flip_mean" | "flip_worst_view" | "flip_p95" | "flip_share" | "vdp_probability"
+        );
+        if !v.is_finite() || (unit && !(0.0..=1.0).contains(&v)) {
+            return Err(format!("threshold {name} = {v} is out of range"));
+        }
+    }
+    Ok(())
+}
+
+/// `0.5` → `50`, `0.025` → `2.5`: a ratio as a percentage label without trailing zeros.
+pub fn percent_label(ratio: f64) -> String {
+    let p = (ratio * 1e4).round() / 100.0;
+    format!("{p}")
+}
+
+/// The folder a config's relative paths start from.
+pub fn config_dir(config_path: &Path) -> PathBuf {
+    match config_path.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
+        _ => PathBuf::from("."),
+    }
+}
+
+/// The config's file stem (`demo` for `configs/demo.toml`).
+pub fn stem(config_path: &Path) -> String {
+    config_path
+        .file_stem()
+        .map_or_else(|| "run".to_string(), |s| s.to_string_lossy().into_owned())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn parse(text: &str) -> Result<Config> {
+        Config::parse(text, Path::new("t.toml"))
+    }
+
+    const MINIMAL: &str = "[[asset]]\nname = \"a\"\nmesh = \"a.obj\"\ngenerate = { method = \"meshopt\", ratios = [0.5] }\n";
+
+    #[test]
+    fn defaults_follow_design() {
+        let c = parse(MINIMAL).unwrap();
+        let s = c.render.settings();
+        assert_eq!((s.width, s.height, s.samples.count()), (512, 512, 4));
+        assert_eq!(c.render.rig.0, Rig::Dodecahedron);
+        assert!((c.viewing.viewing().ppd() - 67.02).abs() < 0.01);
+        assert_eq!(c.metrics, default_metrics());
+        assert_eq!(c.lod_names(&c.assets[0])[0].0, "meshopt-r50");
+    }
+
+    #[test]
+    fn unknown_key_names_key_and_line() {
+        let e = parse(&format!("{MINIMAL}[render]\nsise = 3\n")).unwrap_err();
+        let msg = e.to_string();
+        assert!(msg.contains("line 6") && msg.contains("sise"), "{msg}");
+    }
+
+    #[test]
+    fn bad_values_name_the_line() {
+        for (extra, line, word) in [
+            ("[render]\nsamples = 3\n", 6, "samples"),
+            ("[render]\nrig = \"cube\"\n", 6, "rig"),
+            ("[render]\nshading = \"toon\"\n", 6, "toon"),
+            ("[viewing]\ndistance_m = -1.0\n", 6, "-1"),
+            ("[render]\nsize = 0\n", 6, "out of range"),
+        ] {
+            let msg = parse(&format!("{MINIMAL}{extra}")).unwrap_err().to_string();
+            assert!(
+                msg.contains(&format!("line {line}")) && msg.contains(word),
+                "{extra}: {msg}"
+            );
+        }
+    }
+
+    #[test]
+    fn cross_field_errors() {
+        assert!(parse("metrics = []\n").is_err());
+        let twice = format!("{MINIMAL}{MINIMAL}");
+        assert!(parse(&twice).unwrap_err().to_string().contains("twice"));
+        let none = "[[asset]]\nname = \"a\"\nmesh = \"a.obj\"\n";
+        assert!(parse(none).unwrap_err().to_string().contains("neither"));
+        let bad_t = format!("{MINIMAL}[thresholds]\nflip_mean = 2.0\n");
+        assert!(parse(&bad_t).unwrap_err().to_string().contains("flip_mean"));
+    }
+
+    #[test]
+    fn percent_labels() {
+        assert_eq!(percent_label(0.5), "50");
+        assert_eq!(percent_label(0.025), "2.5");
+        assert_eq!(percent_label(0.05), "5");
+    }
+}

@@ -1,0 +1,259 @@
+//! Imperceptibility distances: from how far away nobody can tell a LOD from its original, and
+//! that distance in each engine's own LOD parameter.
+//!
+//! Geometry. The display is a window of `display_px` × `display_height_px` pixels, `display_width_m`
+//! wide, seen from `distance_m` (DESIGN.md's viewing conditions). A pixel at the centre subtends
+//! 1/k radians with k = distance_m · display_px / display_width_m, which also fixes the engine
+//! camera's vertical field of view (cot(fov/2) = 2k / height_px). An object whose bounding sphere
+//! has radius R (metres) at distance D from the eye projects to a disc of diameter
+//! 2k·R/√(D² − R²) pixels; the inverse is D = R·√(1 + (2k/diameter)²).
+//!
+//! Method. For a candidate on-screen diameter the original and the LOD are rendered exactly as
+//! that viewer would see them (perspective camera at distance D, the display's pixel scale, a
+//! square crop around the object with a 10 % + 4 px border, supersampled), and scored with the VDP
+//! at the display's pixels per degree (and with FLIP). The LOD is imperceptible at that size when
+//! the worst view's detection probability is at or below the configured level (default 0.5, the
+//! 1-JND point of the psychometric function). The search doubles the diameter from 4 px until the
+//! LOD becomes visible, then bisects on the logarithm of the diameter to 2 %; the smallest
+//! distance beyond which the LOD is imperceptible is the distance of the largest invisible
+//! diameter. Views: the `views` worst views of the full-size evaluation (by FLIP, else the first
+//! metric), since the worst view decides.
+//!
+//! Engine parameters at that distance (all from the same sphere, so they agree with each other):
+//! Unity's LODGroup relative screen height (diameter / screen height, `screen_height_fraction`),
+//! Unreal's `ScreenSize` (max(P₀₀, P₁₁)·R/D, as `ComputeBoundsScreenSize` computes it), the
+//! screen coverage of glTF's `MSFT_lod` (disc area / screen area), and meshoptimizer's error
+//! projected to pixels (error · k / D).
+//!
+//! Caveat, stated rather than hidden: probabilities are taken as-is from one render per view;
+//! the VDP is not guaranteed monotone in size, so the bisection finds *a* crossing, the nearest to
+//! the largest size where the LOD was first seen.
+
+use std::collections::BTreeMap;
+
+use glam::Vec3;
+
+use super::config::{DistanceConfig, ViewingConfig};
+use super::tables::{DistanceRow, round7};
+use crate::error::Result;
+use crate::metric::LinearImage;
+use crate::metric::flip::Flip;
+use crate::metric::vdp::{Display, Vdp};
+use crate::raster::{self, RenderSettings, SamplePattern};
+use crate::scene::{Camera, Projection, Scene};
+
+/// The display geometry used to convert between distances and pixels.
+#[derive(Debug, Clone, Copy)]
+pub struct Screen {
+    /// Pixels per radian at the centre (k).
+    pub k: f64,
+    /// Display width in pixels.
+    pub width_px: f64,
+    /// Display height in pixels.
+    pub height_px: f64,
+}
+
+impl Screen {
+    /// From the config's viewing section.
+    pub fn new(v: &ViewingConfig) -> Screen {
+        let k = match v.ppd {
+            // ppd given directly: pixels per radian = ppd · 180/π.
+            Some(p) => p.0 * 180.0 / std::f64::consts::PI,
+            None => v.distance_m.0 * v.display_px.0 / v.display_width_m.0,
+        };
+        Screen {
+            k,
+            width_px: v.display_px.0,
+            height_px: v.display_height_px.0,
+        }
+    }
+
+    /// On-screen diameter in pixels of a sphere of radius `r` at distance `d` (same units).
+    pub fn diameter_px(&self, r: f64, d: f64) -> f64 {
+        2.0 * self.k * r / (d * d - r * r).max(1e-30).sqrt()
+    }
+
+    /// Distance at which a sphere of radius `r` appears `diameter` pixels wide.
+    pub fn distance_for(&self, r: f64, diameter: f64) -> f64 {
+        r * (1.0 + (2.0 * self.k / diameter).powi(2)).sqrt()
+    }
+
+    /// A distance row's engine parameters for radius `r` metres at `d` metres.
+    fn engine_params(&self, r: f64, d: f64) -> (f64, f64, f64) {
+        let diameter = self.diameter_px(r, d);
+        let p11 = 2.0 * self.k / self.height_px;
+        let p00 = 2.0 * self.k / self.width_px;
+        let unreal = p11.max(p00) * r / d;
+        let coverage =
+            std::f64::consts::PI * (diameter / 2.0).powi(2) / (self.width_px * self.height_px);
+        (diameter / self.height_px, unreal, coverage)
+    }
+}
+
+/// Smallest on-screen diameter probed, pixels.
+const MIN_PROBE: u32 = 4;
+
+/// What a search needs about one LOD.
+#[derive(Debug)]
+pub struct DistanceJob<'a> {
+    /// The original.
+    pub original: &'a Scene,
+    /// The LOD.
+    pub lod: &'a Scene,
+    /// View directions to test (the worst views first).
+    pub directions: Vec<Vec3>,
+    /// Metres per model unit.
+    pub meters_per_unit: f64,
+    /// meshoptimizer's error in model units, if known.
+    pub meshopt_error: Option<f64>,
+    /// Asset and LOD names and the LOD's triangle count, for the rows.
+    pub names: (&'a str, &'a str, usize),
+}
+
+/// "Visible at this probe?"
+type Criterion = Box<dyn Fn(&Probe) -> bool>;
+
+/// Worst-view scores at one on-screen diameter.
+#[derive(Debug, Clone, Copy)]
+struct Probe {
+    vdp: f64,
+    flip: f64,
+}
+
+/// Find the distances for one LOD: one row for the VDP criterion and one for FLIP if configured.
+pub fn search(
+    job: &DistanceJob,
+    config: &DistanceConfig,
+    viewing: &ViewingConfig,
+    settings: &RenderSettings,
+) -> Result<Vec<DistanceRow>> {
+    let display = Screen::new(viewing);
+    let view = viewing.viewing();
+    let vdp = Vdp::new(&view, Display::DEFAULT);
+    let flip = Flip::new(view.ppd() as f32);
+    let sphere = job.original.mesh().bounding_sphere();
+    let r_units = sphere.radius as f64;
+    let n = (config.samples.0 as f64).sqrt().round() as u32;
+    let mut probes: BTreeMap<u32, Probe> = BTreeMap::new();
+    let mut probe = |diameter: u32| -> Result<Probe> {
+        if let Some(p) = probes.get(&diameter) {
+            return Ok(*p);
+        }
+        let d_units = display.distance_for(r_units, diameter as f64);
+        let size = (diameter as f64 * 1.1).ceil() as u32 + 8;
+        let mut s = *settings;
+        s.width = size;
+        s.height = size;
+        s.samples = SamplePattern::Rotated(n);
+        // Vertical field of view of `size` display pixels.
+        let fov = 2.0 * ((size as f64 / 2.0) / display.k).atan();
+        let mut worst = Probe {
+            vdp: 0.0,
+            flip: 0.0,
+        };
+        for &dir in &job.directions {
+            let mut cam = Camera::frame_sphere(sphere, dir, 30.0, 1.0, 0.0);
+            let dir = cam.to_eye();
+            cam.eye = sphere.center + dir * d_units as f32;
+            cam.projection = Projection::Perspective {
+                fov_y_deg: fov.to_degrees() as f32,
+            };
+            cam.near = ((d_units - r_units * 1.01) as f32).max(d_units as f32 * 1e-4);
+            cam.far = (d_units + r_units * 1.01) as f32;
+            let a = LinearImage::from(&raster::render(job.original, &cam, &s)?);
+            let b = LinearImage::from(&raster::render(job.lod, &cam, &s)?);
+            let v = vdp.compare(&a, &b)?.probability;
+            let f = flip.compare(&a, &b)?.mean;
+            worst.vdp = worst.vdp.max(v);
+            worst.flip = worst.flip.max(f);
+        }
+        probes.insert(diameter, worst);
+        Ok(worst)
+    };
+    let max_d = config.max_diameter_px.0.max(MIN_PROBE);
+    let mut criteria: Vec<(String, Criterion)> = vec![(
+        format!("vdp_p{}", config.probability.0),
+        Box::new({
+            let level = config.probability.0;
+            move |p: &Probe| p.vdp > level
+        }),
+    )];
+    if let Some(f) = config.flip_mean {
+        criteria.push((
+            format!("flip_mean{}", f.0),
+            Box::new(move |p: &Probe| p.flip > f.0),
+        ));
+    }
+    let mut rows = Vec::new();
+    for (criterion, visible) in &criteria {
+        // Bracket: double from the smallest probe until visible or at the limit.
+        let mut lo = 0u32; // largest diameter known invisible (0: none yet)
+        let mut hi = None; // smallest diameter known visible
+        let mut d = MIN_PROBE.min(max_d);
+        loop {
+            if visible(&probe(d)?) {
+                hi = Some(d);
+                break;
+            }
+            lo = d;
+            if d >= max_d {
+                break;
+            }
+            d = (d * 2).min(max_d);
+        }
+        // Bisect on log(diameter) to 2 %.
+        if let Some(mut h) = hi {
+            while lo > 0 && (h as f64) > lo as f64 * 1.02 && h - lo > 1 {
+                let mid = ((lo as f64 * h as f64).sqrt().round() as u32).clamp(lo + 1, h - 1);
+                if visible(&probe(mid)?) {
+                    h = mid;
+                } else {
+                    lo = mid;
+                }
+            }
+        }
+        // Imperceptible beyond the distance of the largest invisible diameter. When the search hit a
+        // limit (visible at the smallest probe, or invisible up to the largest) it is a bound.
+        let resolved = hi.is_some() && lo > 0;
+        let diameter = if lo == 0 { MIN_PROBE.min(max_d) } else { lo };
+        let r_m = r_units * job.meters_per_unit;
+        let d_m = display.distance_for(r_m, diameter as f64);
+        let (fraction, unreal, coverage) = display.engine_params(r_m, d_m);
+        rows.push(DistanceRow {
+            asset: job.names.0.to_string(),
+            lod: job.names.1.to_string(),
+            triangles: job.names.2,
+            criterion: criterion.clone(),
+            imperceptible_beyond_m: round7(d_m),
+            screen_height_fraction: round7(fraction),
+            unreal_screen_size: round7(unreal),
+            screen_coverage: round7(coverage),
+            pixel_error: job
+                .meshopt_error
+                .map(|e| round7(e * job.meters_per_unit * display.k / d_m)),
+            diameter_px: round7(display.diameter_px(r_m, d_m)),
+            resolved,
+        });
+    }
+    Ok(rows)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn distance_and_diameter_are_inverse() {
+        let d = Screen::new(&ViewingConfig::default());
+        // 0.7 m · 3840 / 0.7 m = 3840 px per radian.
+        assert!((d.k - 3840.0).abs() < 1e-9);
+        for diameter in [3.0, 50.0, 700.0] {
+            let dist = d.distance_for(0.5, diameter);
+            assert!((d.diameter_px(0.5, dist) - diameter).abs() < 1e-9);
+        }
+        // Far away the engine parameters agree: Unreal's screen size ≈ Unity's height fraction.
+        let (frac, unreal, cov) = d.engine_params(1.0, 100.0);
+        assert!((frac - unreal).abs() / frac < 1e-3, "{frac} {unreal}");
+        assert!(cov > 0.0 && cov < frac);
+    }
+}

@@ -1,0 +1,180 @@
+//! The CI gate: thresholds (layered global → asset → LOD, see `plan.rs`), engine switch distances,
+//! and a baseline `summary.csv` with a relative tolerance. Any failure makes `eval` exit 1, with
+//! one line per failing asset/LOD/check giving the value, the limit and where the limit was set.
+//!
+//! Threshold semantics (all per LOD): `flip_mean` bounds the FLIP mean averaged over views; every
+//! other threshold bounds the worst view (`flip_worst_view`, `flip_p95`, `flip_share`,
+//! `vdp_probability` from above; `psnr_min`, `ssim_min`, `msssim_min` from below). A baseline
+//! regression is a summary mean worse than the baseline's by more than
+//! `tolerance · |baseline| + absolute`, in the metric's own direction.
+
+use std::path::Path;
+
+use super::config::config_dir;
+use super::plan::Plan;
+use super::tables::{Results, SummaryRow, higher_is_worse, read_csv};
+use crate::error::{Error, Result};
+
+/// One failed check.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Failure {
+    /// Asset name.
+    pub asset: String,
+    /// LOD name.
+    pub lod: String,
+    /// The check (threshold name, `switch_m` or `baseline:METRIC`).
+    pub check: String,
+    /// The whole message.
+    pub message: String,
+}
+
+/// Evaluate every check of `plan` against `results`.
+pub fn check(plan: &Plan, results: &Results) -> Result<Vec<Failure>> {
+    let mut failures = Vec::new();
+    let computed = |metric: &str| results.rows.iter().any(|r| r.metric == metric);
+    for asset in &plan.assets {
+        for lod in &asset.lods {
+            if !results
+                .lods
+                .iter()
+                .any(|l| l.asset == asset.name && l.lod == lod.name)
+            {
+                continue; // another shard's case
+            }
+            let mut fail = |check: &str, message: String| {
+                failures.push(Failure {
+                    asset: asset.name.clone(),
+                    lod: lod.name.clone(),
+                    check: check.to_string(),
+                    message: format!("FAIL {}/{} {check}: {message}", asset.name, lod.name),
+                })
+            };
+            for limit in &lod.limits {
+                let (metric, worst_view, upper) = match limit.name {
+                    "flip_mean" => ("flip", false, true),
+                    "flip_worst_view" => ("flip", true, true),
+                    "flip_p95" => ("flip_p95", true, true),
+                    "flip_share" => ("flip_share", true, true),
+                    "vdp_probability" => ("vdp", true, true),
+                    "psnr_min" => ("psnr", true, false),
+                    "ssim_min" => ("ssim", true, false),
+                    _ => ("msssim", true, false),
+                };
+                if !computed(metric) {
+                    return Err(Error::input(
+                        &plan.config_path,
+                        format!(
+                            "threshold {} (set in {}) needs the metric '{metric}', which the config does not compute",
+                            limit.name, limit.origin
+                        ),
+                        "add its family to `metrics` or remove the threshold",
+                    ));
+                }
+                let (value, where_) = if worst_view {
+                    match results.worst(&asset.name, &lod.name, metric) {
+                        Some((v, x)) => (x, format!(" (view {v})")),
+                        None => continue,
+                    }
+                } else {
+                    match results.mean(&asset.name, &lod.name, metric) {
+                        Some(x) => (x, " (mean over views)".to_string()),
+                        None => continue,
+                    }
+                };
+                let bad = if upper {
+                    value > limit.value
+                } else {
+                    value < limit.value
+                };
+                if bad {
+                    let op = if upper { ">" } else { "<" };
+                    fail(
+                        limit.name,
+                        format!(
+                            "{metric} = {value}{where_} {op} {} (limit from {})",
+                            limit.value, limit.origin
+                        ),
+                    );
+                }
+            }
+            if let Some(switch) = lod.switch_m {
+                let row = results.distances.iter().find(|d| {
+                    d.asset == asset.name && d.lod == lod.name && d.criterion.starts_with("vdp")
+                });
+                let Some(row) = row else {
+                    return Err(Error::input(
+                        &plan.config_path,
+                        format!(
+                            "asset '{}' LOD '{}' has switch_m but distances are disabled",
+                            asset.name, lod.name
+                        ),
+                        "set [distance] enabled = true or remove switch_m",
+                    ));
+                };
+                if row.imperceptible_beyond_m > switch {
+                    fail(
+                        "switch_m",
+                        format!(
+                            "{} is used from {switch} m but is visible until {:.2} m ({})",
+                            lod.name, row.imperceptible_beyond_m, row.criterion
+                        ),
+                    );
+                }
+            }
+        }
+    }
+    if let Some(baseline) = &plan.config.gate.baseline {
+        let path = config_dir(&plan.config_path).join(baseline);
+        failures.extend(against_baseline(
+            &path,
+            &results.summary(),
+            plan.config.gate.tolerance.unwrap_or(0.1),
+            plan.config.gate.absolute.unwrap_or(1e-4),
+        )?);
+    }
+    Ok(failures)
+}
+
+/// Compare summary means with a baseline `summary.csv`.
+pub fn against_baseline(
+    path: &Path,
+    current: &[SummaryRow],
+    tolerance: f64,
+    absolute: f64,
+) -> Result<Vec<Failure>> {
+    let base: Vec<SummaryRow> = read_csv(path)?;
+    let mut out = Vec::new();
+    for row in current {
+        let Some(b) = base
+            .iter()
+            .find(|b| b.asset == row.asset && b.lod == row.lod && b.metric == row.metric)
+        else {
+            continue;
+        };
+        let slack = tolerance * b.mean.abs() + absolute;
+        let worse = if higher_is_worse(&row.metric) {
+            row.mean > b.mean + slack
+        } else {
+            row.mean < b.mean - slack
+        };
+        if worse && row.mean.is_finite() {
+            let check = format!("baseline:{}", row.metric);
+            out.push(Failure {
+                asset: row.asset.clone(),
+                lod: row.lod.clone(),
+                message: format!(
+                    "FAIL {}/{} {check}: mean {} is worse than the baseline's {} by more than {} % + {} (baseline {})",
+                    row.asset,
+                    row.lod,
+                    row.mean,
+                    b.mean,
+                    tolerance * 100.0,
+                    absolute,
+                    path.display()
+                ),
+                check,
+            });
+        }
+    }
+    Ok(out)
+}

@@ -1,0 +1,151 @@
+//! Golden images (`lodeval golden CONFIG [--bless]`): render every view of each asset's original
+//! (and LODs, unless `[golden] lods = false`) with the config's settings and compare it with the PNG
+//! committed under the golden folder (`ASSET/LOD/view-NN.png`, the original as LOD `original`)
+//! under a perceptual tolerance: FLIP mean and per-pixel 99th percentile at the config's viewing
+//! conditions. On a mismatch the actual render and the FLIP heat map are written to the run's
+//! output folder (`golden/ASSET/LOD/view-NN-actual.png`, `-diff.png`) and the exact bless command
+//! is printed. `--bless` writes new goldens and refuses when the `CI` environment variable is set.
+//!
+//! Decision: both sides are compared as 8-bit sRGB (the render is quantised exactly as the golden
+//! PNG was), so a clean checkout compares equal to its own goldens to the bit.
+
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+use super::config::{config_dir, stem};
+use super::plan::Plan;
+use crate::error::{Error, Result};
+use crate::mesh::{self, LoadOptions, Mesh};
+use crate::metric::flip::Flip;
+use crate::metric::{LinearImage, colormap, pool};
+
+use crate::raster;
+
+/// What `golden` found.
+#[derive(Debug, Default)]
+pub struct GoldenOutcome {
+    /// Images compared (or blessed).
+    pub checked: usize,
+    /// One line per mismatch or missing golden.
+    pub mismatches: Vec<String>,
+    /// Files written (blessed goldens, or actual/diff images of mismatches).
+    pub written: Vec<PathBuf>,
+}
+
+/// The golden folder of a plan.
+pub fn golden_dir(plan: &Plan) -> PathBuf {
+    let base = config_dir(&plan.config_path);
+    match &plan.config.golden.dir {
+        Some(d) => base.join(d),
+        None => base
+            .join("..")
+            .join("reference")
+            .join("golden")
+            .join(stem(&plan.config_path)),
+    }
+}
+
+/// Compare (or with `bless`, write) the goldens of `plan`. `ci` says whether the `CI` environment
+/// variable is set; `out_dir` receives actual and diff images of mismatches.
+pub fn run(plan: &Plan, bless: bool, ci: bool, out_dir: &Path) -> Result<GoldenOutcome> {
+    if bless && ci {
+        return Err(Error::Usage(
+            "refusing to bless golden images with CI set: goldens are updated by a person, \
+             on purpose; run `lodeval golden CONFIG --bless` locally and commit the images"
+                .into(),
+        ));
+    }
+    let cfg = &plan.config;
+    let dir = golden_dir(plan);
+    let settings = cfg.render.settings();
+    let flip = Flip::new(cfg.viewing.viewing().ppd() as f32);
+    let mut outcome = GoldenOutcome::default();
+    for asset in &plan.assets {
+        let original = Arc::new(mesh::load(&asset.mesh, &LoadOptions::default())?);
+        let cameras = crate::commands::rig_cameras(&original, &cfg.render.rig.0, 1.0);
+        let mut meshes: Vec<(String, Mesh)> = vec![("original".into(), (*original).clone())];
+        if cfg.golden.lods {
+            let all = vec![true; asset.lods.len()];
+            for (name, m, _) in super::run::build_lods(asset, &original, &all)? {
+                meshes.push((name, m));
+            }
+        }
+        for (name, m) in meshes {
+            let scene = super::run::scene_for(cfg, Arc::new(m));
+            for (v, cam) in cameras.iter().enumerate() {
+                let rel = Path::new(&asset.name)
+                    .join(&name)
+                    .join(format!("view-{v:02}.png"));
+                let golden_path = dir.join(&rel);
+                let actual = raster::render(&scene, cam, &settings)?.to_srgb8();
+                outcome.checked += 1;
+                if bless {
+                    crate::io::write_image(&golden_path, &image::DynamicImage::ImageRgb8(actual))?;
+                    outcome.written.push(golden_path);
+                    continue;
+                }
+                let problem = compare(&flip, &golden_path, &actual, cfg)?;
+                if let Some((why, diff)) = problem {
+                    let base = out_dir.join("golden").join(&rel);
+                    let actual_path = base.with_file_name(format!("view-{v:02}-actual.png"));
+                    crate::io::write_image(&actual_path, &image::DynamicImage::ImageRgb8(actual))?;
+                    outcome.written.push(actual_path.clone());
+                    let mut line = format!(
+                        "MISMATCH {}: {why}; actual: {}",
+                        golden_path.display(),
+                        actual_path.display()
+                    );
+                    if let Some(diff) = diff {
+                        let diff_path = base.with_file_name(format!("view-{v:02}-diff.png"));
+                        crate::io::write_image(&diff_path, &image::DynamicImage::ImageRgb8(diff))?;
+                        line.push_str(&format!(", diff: {}", diff_path.display()));
+                        outcome.written.push(diff_path);
+                    }
+                    outcome.mismatches.push(line);
+                }
+            }
+        }
+    }
+    Ok(outcome)
+}
+
+/// Compare a render with its golden; `None` when within tolerance, else the reason and (when
+/// the sizes agree) the FLIP heat map.
+fn compare(
+    flip: &Flip,
+    golden_path: &Path,
+    actual: &image::RgbImage,
+    cfg: &super::config::Config,
+) -> Result<Option<(String, Option<image::RgbImage>)>> {
+    if !golden_path.exists() {
+        return Ok(Some(("no golden image".into(), None)));
+    }
+    let golden = LinearImage::load(golden_path)?;
+    let (w, h) = (actual.width() as usize, actual.height() as usize);
+    if (golden.width(), golden.height()) != (w, h) {
+        return Ok(Some((
+            format!(
+                "golden is {}x{}, the render {w}x{h}",
+                golden.width(),
+                golden.height()
+            ),
+            None,
+        )));
+    }
+    let test = LinearImage::from_srgb8(w, h, actual.as_raw())
+        .ok_or_else(|| Error::Internal("render size mismatch".into()))?;
+    let s = flip.compare(&golden, &test)?;
+    let p99 = pool::percentile(&s.map.values, 99.0);
+    let (tm, tp) = (cfg.golden.flip_mean.0, cfg.golden.flip_p99.0);
+    if s.mean <= tm && p99 <= tp {
+        return Ok(None);
+    }
+    let why = format!(
+        "FLIP mean {:.5} (limit {tm}), p99 {:.5} (limit {tp})",
+        s.mean, p99
+    );
+    Ok(Some((
+        why,
+        Some(colormap::heat_map(&s.map.values, w, h, (h / 32).max(4))),
+    )))
+}

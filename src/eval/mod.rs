@@ -1,0 +1,258 @@
+//! Batch evaluation: configs → plan → renders and scores → the output files of DESIGN.md → the
+//! gate's exit code. One stage per file:
+//!
+//! - `config.rs` — the TOML schema, defaults, and exit-2 messages with file and line;
+//! - `plan.rs` — assets × LODs, layered thresholds, shards;
+//! - `run.rs` — the render-and-score loop, heat maps, contact sheets;
+//! - `score.rs` — the metric families per view pair;
+//! - `distance.rs` — imperceptibility distances and engine LOD parameters;
+//! - `tables.rs` — `metrics.csv`, `summary.csv`, `distances.csv`, `lods.csv`;
+//! - `gate.rs` — thresholds, switch distances, baseline comparison;
+//! - `junit.rs`, `report.rs` — `junit.xml`, `report.html`;
+//! - `golden.rs` — golden-image compare and bless.
+//!
+//! This file joins them: [`eval`] runs a config (or one shard of it) and writes every output,
+//! [`merge`] joins shard outputs into exactly the files one machine would have written. Every
+//! run also writes `shard.json` (the config text, the shard and its cases) so a merge needs
+//! nothing but the folders.
+
+pub mod config;
+pub mod distance;
+pub mod gate;
+pub mod golden;
+pub mod junit;
+pub mod plan;
+pub mod report;
+pub mod run;
+pub mod score;
+pub mod tables;
+
+use std::path::{Path, PathBuf};
+
+use serde::{Deserialize, Serialize};
+
+pub use gate::Failure;
+pub use plan::{Plan, Shard};
+pub use run::RunOptions;
+pub use tables::Results;
+
+use crate::error::{Error, Result};
+
+/// What a run or a merge produced.
+#[derive(Debug)]
+pub struct Outcome {
+    /// Output folder.
+    pub out_dir: PathBuf,
+    /// The tables.
+    pub results: Results,
+    /// Gate failures (empty: pass).
+    pub failures: Vec<Failure>,
+    /// The plan.
+    pub plan: Plan,
+}
+
+/// `shard.json`: what a (shard of a) run covered.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+struct Manifest {
+    config_path: PathBuf,
+    config_text: String,
+    shard: String,
+    cases: Vec<String>,
+}
+
+/// Run a config (one shard of it) and write every output.
+pub fn eval(config: &Path, options: &RunOptions) -> Result<Outcome> {
+    let plan = Plan::load(config)?;
+    let out = run::run(plan, options)?;
+    let manifest = Manifest {
+        config_path: out.plan.config_path.clone(),
+        config_text: out.plan.config_text.clone(),
+        shard: format!("{}/{}", options.shard.index, options.shard.count),
+        cases: out
+            .plan
+            .case_ids()
+            .into_iter()
+            .filter(|c| options.shard.contains(c))
+            .collect(),
+    };
+    finish(out.plan, out.out_dir, out.results, &manifest)
+}
+
+/// Write the tables, gate, JUnit, report and manifest; returns the outcome.
+fn finish(plan: Plan, out_dir: PathBuf, results: Results, manifest: &Manifest) -> Result<Outcome> {
+    results.write_csvs(&out_dir)?;
+    let failures = gate::check(&plan, &results)?;
+    crate::io::write_atomic(
+        &out_dir.join("junit.xml"),
+        junit::render(&plan, &results, &failures)?.as_bytes(),
+    )?;
+    crate::io::write_atomic(
+        &out_dir.join("report.html"),
+        report::render(&plan, &results, &failures).as_bytes(),
+    )?;
+    let json = serde_json::to_string_pretty(manifest)
+        .map_err(|e| Error::Internal(format!("shard.json: {e}")))?;
+    crate::io::write_atomic(&out_dir.join("shard.json"), json.as_bytes())?;
+    Ok(Outcome {
+        out_dir,
+        results,
+        failures,
+        plan,
+    })
+}
+
+/// Join the outputs of shard runs into `out`: fails (exit 2) when the shards ran different
+/// configs, a case ran twice, or a case of the plan is missing.
+pub fn merge(dirs: &[PathBuf], out: &Path) -> Result<Outcome> {
+    if dirs.is_empty() {
+        return Err(Error::Usage("merge needs at least one shard folder".into()));
+    }
+    let mut manifests = Vec::new();
+    for d in dirs {
+        let path = d.join("shard.json");
+        let text = std::fs::read_to_string(&path).map_err(|e| {
+            Error::input(
+                &path,
+                format!("cannot read: {e}"),
+                "give folders written by `lodeval eval --shard`",
+            )
+        })?;
+        let m: Manifest = serde_json::from_str(&text).map_err(|e| {
+            Error::input(
+                &path,
+                format!("is not an lodeval shard manifest: {e}"),
+                "give folders written by `lodeval eval --shard`",
+            )
+        })?;
+        manifests.push(m);
+    }
+    let first = &manifests[0];
+    for (m, d) in manifests.iter().zip(dirs).skip(1) {
+        if m.config_text != first.config_text {
+            return Err(Error::input(
+                &d.join("shard.json"),
+                format!(
+                    "ran a different config than {} did",
+                    dirs[0].join("shard.json").display()
+                ),
+                "merge only shards of one run of one config",
+            ));
+        }
+    }
+    let plan = Plan::from_text(first.config_text.clone(), &first.config_path)?;
+    let mut seen: std::collections::BTreeMap<&str, &Path> = Default::default();
+    for (m, d) in manifests.iter().zip(dirs) {
+        for c in &m.cases {
+            if let Some(other) = seen.insert(c, d) {
+                return Err(Error::input(
+                    &d.join("shard.json"),
+                    format!("case {c} is also in {}", other.display()),
+                    "merge each shard once; shards of one run never share a case",
+                ));
+            }
+        }
+    }
+    let all = plan.case_ids();
+    if let Some(missing) = all.iter().find(|c| !seen.contains_key(c.as_str())) {
+        return Err(Error::Usage(format!(
+            "case {missing} is in no shard folder: run its shard (and give all {} shards)",
+            first.shard.split('/').nth(1).unwrap_or("?")
+        )));
+    }
+    let mut results = Results::default();
+    for d in dirs {
+        let r = Results::read_csvs(d)?;
+        results.rows.extend(r.rows);
+        results.lods.extend(r.lods);
+        results.distances.extend(r.distances);
+        for sub in ["heatmaps", "sheets"] {
+            copy_tree(&d.join(sub), &out.join(sub))?;
+        }
+    }
+    results.sort(&all);
+    let manifest = Manifest {
+        config_path: first.config_path.clone(),
+        config_text: first.config_text.clone(),
+        shard: "0/1".into(),
+        cases: all,
+    };
+    finish(plan, out.to_path_buf(), results, &manifest)
+}
+
+fn copy_tree(from: &Path, to: &Path) -> Result<()> {
+    let Ok(entries) = std::fs::read_dir(from) else {
+        return Ok(());
+    };
+    let mut entries: Vec<_> = entries.filter_map(|e| e.ok()).collect();
+    entries.sort_by_key(|e| e.file_name());
+    for e in entries {
+        let (src, dst) = (e.path(), to.join(e.file_name()));
+        if src.is_dir() {
+            copy_tree(&src, &dst)?;
+        } else {
+            let bytes = std::fs::read(&src).map_err(|err| {
+                Error::input(
+                    &src,
+                    format!("cannot read: {err}"),
+                    "check the shard folder",
+                )
+            })?;
+            crate::io::write_atomic(&dst, &bytes)?;
+        }
+    }
+    Ok(())
+}
+
+/// The table `eval` prints: one line per LOD.
+pub fn summary_table(outcome: &Outcome) -> String {
+    let r = &outcome.results;
+    let mut s = format!(
+        "{:<12} {:<16} {:>9} {:>7} {:>9} {:>9} {:>8} {:>8} {:>10}  gate\n",
+        "asset",
+        "lod",
+        "triangles",
+        "ratio",
+        "flip",
+        "flip_max",
+        "psnr_min",
+        "vdp_max",
+        "visible_m"
+    );
+    let fmt = |v: Option<f64>, d: usize| match v {
+        Some(x) if x.is_finite() => format!("{x:.d$}"),
+        Some(_) => "inf".into(),
+        None => "-".into(),
+    };
+    for l in &r.lods {
+        let worst = |m: &str| r.worst(&l.asset, &l.lod, m).map(|w| w.1);
+        let dist = r
+            .distances
+            .iter()
+            .find(|d| d.asset == l.asset && d.lod == l.lod && d.criterion.starts_with("vdp"))
+            .map(|d| {
+                format!(
+                    "{}{:.2}",
+                    if d.resolved { "" } else { "~" },
+                    d.imperceptible_beyond_m
+                )
+            });
+        let failed = outcome
+            .failures
+            .iter()
+            .any(|f| f.asset == l.asset && f.lod == l.lod);
+        s.push_str(&format!(
+            "{:<12} {:<16} {:>9} {:>7.4} {:>9} {:>9} {:>8} {:>8} {:>10}  {}\n",
+            l.asset,
+            l.lod,
+            l.triangles,
+            l.triangles as f64 / l.original_triangles.max(1) as f64,
+            fmt(r.mean(&l.asset, &l.lod, "flip"), 4),
+            fmt(worst("flip"), 4),
+            fmt(worst("psnr"), 2),
+            fmt(worst("vdp"), 3),
+            dist.unwrap_or_else(|| "-".into()),
+            if failed { "FAIL" } else { "pass" }
+        ));
+    }
+    s
+}

@@ -1,0 +1,337 @@
+//! The plan: a parsed config expanded into assets × LODs (with resolved paths, generator steps,
+//! layered thresholds and engine switch distances) and split into shards.
+//!
+//! Decisions:
+//! - A case is one (asset, LOD) pair, id `ASSET/LOD`. Shards split cases by a stable hash of the
+//!   id (64-bit FNV-1a), so adding an asset moves no other case between shards. Every shard that
+//!   has a case of an asset renders that asset's original itself (no shared state between
+//!   machines).
+//! - Generated LODs form a chain: each step is simplified from the previous one (as engines
+//!   build LOD chains), ratios first in the given order, then error targets.
+
+use std::path::{Path, PathBuf};
+
+use super::config::{Config, Thresholds, config_dir};
+use crate::error::{Error, Result};
+use crate::simplify::meshopt::Target;
+
+/// Where a LOD's mesh comes from.
+#[derive(Debug, Clone, PartialEq)]
+pub enum LodSource {
+    /// A file.
+    File(PathBuf),
+    /// Step `step` (0-based) of the asset's meshoptimizer chain.
+    Meshopt {
+        /// Position in the chain.
+        step: usize,
+        /// Ratio of the original's triangles or relative error.
+        target: GenTarget,
+    },
+}
+
+/// A generator step's target.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum GenTarget {
+    /// Fraction of the original's triangle count.
+    Ratio(f64),
+    /// meshoptimizer relative error.
+    Error(f64),
+}
+
+impl GenTarget {
+    /// The simplifier target for an original of `triangles` triangles.
+    pub fn target(self, triangles: usize) -> Target {
+        match self {
+            GenTarget::Ratio(r) => {
+                Target::Triangles((triangles as f64 * r).round().max(1.0) as usize)
+            }
+            GenTarget::Error(e) => Target::Error(e as f32),
+        }
+    }
+}
+
+/// One resolved threshold: its value and where it was set.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Limit {
+    /// Threshold key (see [`Thresholds`]).
+    pub name: &'static str,
+    /// Its value.
+    pub value: f64,
+    /// Where it was set, e.g. `configs/ci.toml [thresholds]`.
+    pub origin: String,
+}
+
+/// One LOD of an asset.
+#[derive(Debug, Clone)]
+pub struct LodPlan {
+    /// Name in outputs.
+    pub name: String,
+    /// Mesh source.
+    pub source: LodSource,
+    /// The engine's switch distance, metres, if the config gives one.
+    pub switch_m: Option<f64>,
+    /// Resolved thresholds.
+    pub limits: Vec<Limit>,
+}
+
+/// One asset.
+#[derive(Debug, Clone)]
+pub struct AssetPlan {
+    /// Name in outputs.
+    pub name: String,
+    /// The original mesh.
+    pub mesh: PathBuf,
+    /// Metres per model unit.
+    pub meters_per_unit: f64,
+    /// Its LODs, in chain order.
+    pub lods: Vec<LodPlan>,
+}
+
+/// Everything a run will do.
+#[derive(Debug, Clone)]
+pub struct Plan {
+    /// The parsed config.
+    pub config: Config,
+    /// The config file.
+    pub config_path: PathBuf,
+    /// The config text (kept so shard outputs can be merged without the file).
+    pub config_text: String,
+    /// Assets in config order.
+    pub assets: Vec<AssetPlan>,
+}
+
+/// A case id: `ASSET/LOD`.
+pub fn case_id(asset: &str, lod: &str) -> String {
+    format!("{asset}/{lod}")
+}
+
+impl Plan {
+    /// Parse and expand a config file.
+    pub fn load(config_path: &Path) -> Result<Plan> {
+        let text = std::fs::read_to_string(config_path).map_err(|e| {
+            Error::input(
+                config_path,
+                format!("cannot read the config: {e}"),
+                "check the path",
+            )
+        })?;
+        Plan::from_text(text, config_path)
+    }
+
+    /// Expand config text; `config_path` anchors relative paths.
+    pub fn from_text(text: String, config_path: &Path) -> Result<Plan> {
+        let config = Config::parse(&text, config_path)?;
+        let base = config_dir(config_path);
+        let file = config_path.display().to_string();
+        let global = layer(&config.thresholds, &format!("{file} [thresholds]"), &[]);
+        let mut assets = Vec::new();
+        for a in &config.assets {
+            let asset_limits = layer(
+                &a.thresholds,
+                &format!("{file} asset '{}' thresholds", a.name.0),
+                &global,
+            );
+            let names = config.lod_names(a);
+            let mut lods = Vec::new();
+            for (i, l) in a.lods.iter().enumerate() {
+                lods.push(LodPlan {
+                    name: names[i].0.clone(),
+                    source: LodSource::File(base.join(&l.mesh)),
+                    switch_m: l.switch_m.map(|s| s.0),
+                    limits: layer(
+                        &l.thresholds,
+                        &format!(
+                            "{file} asset '{}' LOD '{}' thresholds",
+                            a.name.0, names[i].0
+                        ),
+                        &asset_limits,
+                    ),
+                });
+            }
+            if let Some(g) = &a.generate {
+                let targets = g
+                    .ratios
+                    .iter()
+                    .map(|r| GenTarget::Ratio(r.0))
+                    .chain(g.errors.iter().map(|e| GenTarget::Error(e.0)));
+                for (step, target) in targets.enumerate() {
+                    lods.push(LodPlan {
+                        name: names[a.lods.len() + step].0.clone(),
+                        source: LodSource::Meshopt { step, target },
+                        switch_m: g.switch_m.get(step).map(|s| s.0),
+                        limits: asset_limits.clone(),
+                    });
+                }
+            }
+            assets.push(AssetPlan {
+                name: a.name.0.clone(),
+                mesh: base.join(&a.mesh),
+                meters_per_unit: a.meters_per_unit.0,
+                lods,
+            });
+        }
+        Ok(Plan {
+            config,
+            config_path: config_path.to_path_buf(),
+            config_text: text,
+            assets,
+        })
+    }
+
+    /// Every case id in plan order.
+    pub fn case_ids(&self) -> Vec<String> {
+        self.assets
+            .iter()
+            .flat_map(|a| a.lods.iter().map(|l| case_id(&a.name, &l.name)))
+            .collect()
+    }
+}
+
+/// Overlay `t` on `below`: fields set in `t` replace the same names.
+fn layer(t: &Thresholds, origin: &str, below: &[Limit]) -> Vec<Limit> {
+    let mut out: Vec<Limit> = below.to_vec();
+    for (name, value) in t.entries() {
+        let Some(value) = value else { continue };
+        let limit = Limit {
+            name,
+            value,
+            origin: origin.to_string(),
+        };
+        match out.iter_mut().find(|l| l.name == name) {
+            Some(l) => *l = limit,
+            None => out.push(limit),
+        }
+    }
+    out
+}
+
+/// One shard of a run: `index` in `0..count`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Shard {
+    /// 0-based shard index.
+    pub index: u32,
+    /// Number of shards.
+    pub count: u32,
+}
+
+impl Shard {
+    /// The whole run.
+    pub const ALL: Shard = Shard { index: 0, count: 1 };
+
+    /// Parse `INDEX/COUNT` (0-based index).
+    pub fn parse(text: &str) -> Result<Shard> {
+        let bad = || {
+            Error::Usage(format!(
+                "--shard '{text}': use INDEX/COUNT with 0 ≤ INDEX < COUNT, e.g. 0/2"
+            ))
+        };
+        let (i, n) = text.split_once('/').ok_or_else(bad)?;
+        let (index, count): (u32, u32) = (
+            i.trim().parse().map_err(|_| bad())?,
+            n.trim().parse().map_err(|_| bad())?,
+        );
+        if count == 0 || index >= count {
+            return Err(bad());
+        }
+        Ok(Shard { index, count })
+    }
+
+    /// The shard named by the environment of common CI systems and Kubernetes indexed jobs:
+    /// `TEST_SHARD_INDEX`/`TEST_TOTAL_SHARDS` (Bazel-style), `CI_NODE_INDEX`/`CI_NODE_TOTAL`
+    /// (GitLab, 1-based index), `JOB_COMPLETION_INDEX` with `LODEVAL_SHARD_COUNT` (Kubernetes).
+    pub fn from_env(get: impl Fn(&str) -> Option<String>) -> Result<Option<Shard>> {
+        let pair = |i: &str, n: &str, one_based: bool| -> Result<Option<Shard>> {
+            match (get(i), get(n)) {
+                (Some(i), Some(n)) => {
+                    let idx: u32 = i.trim().parse().map_err(|_| {
+                        Error::Usage(format!("environment shard index '{i}' is not a number"))
+                    })?;
+                    let idx = if one_based {
+                        idx.saturating_sub(1)
+                    } else {
+                        idx
+                    };
+                    Shard::parse(&format!("{idx}/{}", n.trim())).map(Some)
+                }
+                _ => Ok(None),
+            }
+        };
+        if let Some(s) = pair("TEST_SHARD_INDEX", "TEST_TOTAL_SHARDS", false)? {
+            return Ok(Some(s));
+        }
+        if let Some(s) = pair("CI_NODE_INDEX", "CI_NODE_TOTAL", true)? {
+            return Ok(Some(s));
+        }
+        pair("JOB_COMPLETION_INDEX", "LODEVAL_SHARD_COUNT", false)
+    }
+
+    /// Whether this shard runs `case`.
+    pub fn contains(&self, case: &str) -> bool {
+        fnv1a(case.as_bytes()) % self.count as u64 == self.index as u64
+    }
+}
+
+/// 64-bit FNV-1a.
+fn fnv1a(bytes: &[u8]) -> u64 {
+    bytes.iter().fold(0xcbf2_9ce4_8422_2325, |h, &b| {
+        (h ^ b as u64).wrapping_mul(0x0100_0000_01b3)
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn thresholds_layer_and_remember_their_origin() {
+        let text = r#"
+[thresholds]
+flip_mean = 0.1
+psnr_min = 20.0
+[[asset]]
+name = "a"
+mesh = "a.obj"
+thresholds = { flip_mean = 0.05 }
+lods = [{ mesh = "a1.obj", thresholds = { psnr_min = 30.0 } }, { mesh = "a2.obj" }]
+"#;
+        let p = Plan::from_text(text.into(), Path::new("c/x.toml")).unwrap();
+        let l = &p.assets[0].lods;
+        let get = |lod: &LodPlan, n: &str| {
+            let x = lod.limits.iter().find(|l| l.name == n).unwrap();
+            (x.value, x.origin.clone())
+        };
+        assert_eq!(get(&l[0], "flip_mean").0, 0.05);
+        assert!(get(&l[0], "flip_mean").1.contains("asset 'a' thresholds"));
+        assert_eq!(get(&l[0], "psnr_min").0, 30.0);
+        assert!(get(&l[0], "psnr_min").1.contains("LOD 'lod1'"));
+        assert_eq!(get(&l[1], "psnr_min").0, 20.0);
+        assert!(get(&l[1], "psnr_min").1.contains("[thresholds]"));
+        assert_eq!(p.assets[0].mesh, Path::new("c/a.obj"));
+    }
+
+    #[test]
+    fn shards_partition_cases() {
+        let ids: Vec<String> = (0..200)
+            .map(|i| format!("asset{}/lod{}", i / 7, i % 7))
+            .collect();
+        for count in [1, 2, 3, 8] {
+            let mut seen = 0;
+            for index in 0..count {
+                let s = Shard { index, count };
+                seen += ids.iter().filter(|c| s.contains(c)).count();
+            }
+            assert_eq!(seen, ids.len());
+        }
+        assert!(Shard::parse("2/2").is_err() && Shard::parse("x").is_err());
+        assert_eq!(Shard::parse("1/3").unwrap(), Shard { index: 1, count: 3 });
+        let env = |k: &str| match k {
+            "CI_NODE_INDEX" => Some("2".to_string()),
+            "CI_NODE_TOTAL" => Some("4".to_string()),
+            _ => None,
+        };
+        assert_eq!(
+            Shard::from_env(env).unwrap(),
+            Some(Shard { index: 1, count: 4 })
+        );
+    }
+}

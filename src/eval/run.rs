@@ -1,0 +1,355 @@
+//! The batch run behind `lodeval eval`: load each asset and its LODs (files or the meshoptimizer
+//! chain), render the original once per view as the metric reference, render every LOD from the
+//! same camera, score, write heat maps and contact sheets, search the imperceptibility distances,
+//! then hand the tables to the sinks (CSV, gate, JUnit, report).
+//!
+//! Decisions:
+//! - Views are the outer loop: one original render and its prepared metric forms are alive at a
+//!   time, so memory does not grow with the number of views (1024² nightly runs stay small).
+//!   Parallelism lives inside the renderer and the metrics, so results never depend on which
+//!   thread finished first.
+//! - Every LOD is rendered with the original's cameras (framed on the original's bounding sphere),
+//!   as an engine would draw it in the original's place.
+//! - Contact sheets show original | LOD | FLIP heat map (VDP where FLIP is off; SSIM last), the
+//!   LOD's worst views first, as 256-pixel thumbnails.
+
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+use super::config::{HeatmapChoice, MetricFamily};
+use super::distance::{self, DistanceJob};
+use super::plan::{AssetPlan, GenTarget, LodSource, Plan, Shard, case_id};
+use super::score::Scorer;
+use super::tables::{LodInfo, MetricRow, Results, higher_is_worse, round7};
+use crate::error::Result;
+use crate::mesh::{self, LoadOptions, Mesh};
+use crate::metric::{LinearImage, colormap};
+use crate::raster;
+use crate::scene::Scene;
+use crate::simplify::meshopt;
+
+/// How to run.
+#[derive(Debug, Clone)]
+pub struct RunOptions {
+    /// Output folder override (else the config's).
+    pub out: Option<PathBuf>,
+    /// The shard to run.
+    pub shard: Shard,
+    /// Draw a progress bar (on a terminal, not quiet).
+    pub progress: bool,
+}
+
+/// A finished (sharded) run.
+#[derive(Debug)]
+pub struct RunOutput {
+    /// The plan.
+    pub plan: Plan,
+    /// Where the files went.
+    pub out_dir: PathBuf,
+    /// The tables.
+    pub results: Results,
+}
+
+/// A LOD ready to render.
+struct LodScene {
+    name: String,
+    scene: Scene,
+    info: LodInfo,
+}
+
+/// Thumbnails kept for one LOD's contact sheet: per view (original, LOD, heat map).
+type SheetViews = Vec<(usize, [image::RgbImage; 3])>;
+
+const THUMB: u32 = 256;
+
+/// Run `plan`'s cases in `options.shard`, writing images into the output folder. The tables are
+/// returned (written by the caller with the other sinks).
+pub fn run(plan: Plan, options: &RunOptions) -> Result<RunOutput> {
+    let out_dir = plan
+        .config
+        .out_dir(&plan.config_path, options.out.as_deref());
+    let cfg = &plan.config;
+    let viewing = cfg.viewing.viewing();
+    let scorer = Scorer::new(&cfg.metrics, &viewing, cfg.flip_pixel_threshold.0);
+    let settings = cfg.render.settings();
+    let mut results = Results::default();
+    let cases: usize = plan
+        .assets
+        .iter()
+        .flat_map(|a| a.lods.iter().map(|l| case_id(&a.name, &l.name)))
+        .filter(|c| options.shard.contains(c))
+        .count();
+    let views = cfg.render.rig.0.directions().len();
+    let steps = cases * (views + usize::from(cfg.distance.enabled));
+    let bar = progress_bar(options.progress, steps as u64);
+    for asset in &plan.assets {
+        let wanted: Vec<bool> = asset
+            .lods
+            .iter()
+            .map(|l| options.shard.contains(&case_id(&asset.name, &l.name)))
+            .collect();
+        if !wanted.contains(&true) {
+            continue;
+        }
+        bar.set_message(asset.name.clone());
+        let original = Arc::new(mesh::load(&asset.mesh, &LoadOptions::default())?);
+        let reference = scene_for(cfg, original.clone());
+        let lods = build_lods(asset, &original, &wanted)?
+            .into_iter()
+            .map(|(name, mesh, info)| LodScene {
+                name,
+                scene: scene_for(cfg, Arc::new(mesh)),
+                info,
+            })
+            .collect::<Vec<_>>();
+        let cameras = crate::commands::rig_cameras(&original, &cfg.render.rig.0, 1.0);
+        let mut sheets: Vec<SheetViews> = vec![Vec::new(); lods.len()];
+        for (v, camera) in cameras.iter().enumerate() {
+            let frame = raster::render(&reference, camera, &settings)?;
+            let ref_thumb = thumbnail(&frame.to_srgb8());
+            let prepared = scorer.prepare(LinearImage::from(&frame));
+            for (k, lod) in lods.iter().enumerate() {
+                let test_frame = raster::render(&lod.scene, camera, &settings)?;
+                let scored = scorer.score(&prepared, &LinearImage::from(&test_frame))?;
+                for (metric, value) in &scored.values {
+                    results.rows.push(MetricRow {
+                        asset: asset.name.clone(),
+                        lod: lod.name.clone(),
+                        triangles: lod.info.triangles,
+                        view: v,
+                        metric: metric.to_string(),
+                        value: *value,
+                    });
+                }
+                if cfg.images.heatmaps == HeatmapChoice::All {
+                    for (metric, map) in &scored.maps {
+                        write_heat_map(&out_dir, &asset.name, &lod.name, v, metric, map)?;
+                    }
+                }
+                if let Some((_, map)) = scored.maps.first() {
+                    let heat = colormap::heat_map(&map.values, map.width, map.height, 0);
+                    sheets[k].push((
+                        v,
+                        [
+                            ref_thumb.clone(),
+                            thumbnail(&test_frame.to_srgb8()),
+                            thumbnail(&heat),
+                        ],
+                    ));
+                }
+                bar.inc(1);
+            }
+        }
+        for (k, lod) in lods.iter().enumerate() {
+            let order = worst_first(&results, &asset.name, &lod.name, &cfg.metrics);
+            if cfg.images.heatmaps == HeatmapChoice::Worst
+                && let Some(&worst) = order.first()
+            {
+                // Re-render the worst view only, for its heat maps.
+                let a = LinearImage::from(&raster::render(&reference, &cameras[worst], &settings)?);
+                let b = LinearImage::from(&raster::render(&lod.scene, &cameras[worst], &settings)?);
+                let scored = scorer.score(&scorer.prepare(a), &b)?;
+                for (metric, map) in &scored.maps {
+                    write_heat_map(&out_dir, &asset.name, &lod.name, worst, metric, map)?;
+                }
+            }
+            if cfg.images.contact_sheets && !sheets[k].is_empty() {
+                let mut tiles = Vec::new();
+                for &v in order.iter().take(cfg.images.sheet_views.max(1)) {
+                    if let Some((_, t)) = sheets[k].iter().find(|(view, _)| *view == v) {
+                        tiles.extend(t.iter().cloned());
+                    }
+                }
+                let sheet = raster::contact_sheet(&tiles, 3, 4, [32, 32, 32]);
+                crate::io::write_image(
+                    &out_dir
+                        .join("sheets")
+                        .join(&asset.name)
+                        .join(format!("{}.png", lod.name)),
+                    &image::DynamicImage::ImageRgb8(sheet),
+                )?;
+            }
+            if cfg.distance.enabled {
+                bar.set_message(format!("{} {} distance", asset.name, lod.name));
+                let take = cfg.distance.views.unwrap_or(3).max(1);
+                let directions = order
+                    .iter()
+                    .take(take)
+                    .map(|&v| cameras[v].to_eye())
+                    .collect();
+                let job = DistanceJob {
+                    original: &reference,
+                    lod: &lod.scene,
+                    directions,
+                    meters_per_unit: asset.meters_per_unit,
+                    meshopt_error: lod.info.meshopt_error,
+                    names: (&asset.name, &lod.name, lod.info.triangles),
+                };
+                results.distances.extend(distance::search(
+                    &job,
+                    &cfg.distance,
+                    &cfg.viewing,
+                    &settings,
+                )?);
+                bar.inc(1);
+            }
+        }
+        results.lods.extend(lods.into_iter().map(|l| l.info));
+    }
+    bar.finish_and_clear();
+    results.sort(&plan.case_ids());
+    Ok(RunOutput {
+        plan,
+        out_dir,
+        results,
+    })
+}
+
+/// A scene of `mesh` with the config's lights, background and ambient term.
+pub fn scene_for(cfg: &super::config::Config, mesh: Arc<Mesh>) -> Scene {
+    let mut s = Scene::new(mesh);
+    s.lights = cfg.render.scene_lights();
+    s.background = glam::Vec3::from_array(cfg.render.background.map(|c| c.0 as f32))
+        .map(crate::metric::color::srgb_to_linear);
+    s.ambient = cfg.render.ambient.0 as f32;
+    s
+}
+
+/// Load or generate the wanted LODs of an asset (generated chains are built up to the last
+/// wanted step, since each step starts from the previous one).
+pub fn build_lods(
+    asset: &AssetPlan,
+    original: &Mesh,
+    wanted: &[bool],
+) -> Result<Vec<(String, Mesh, LodInfo)>> {
+    let mut out = Vec::new();
+    let last_generated = asset
+        .lods
+        .iter()
+        .zip(wanted)
+        .filter(|(l, w)| **w && matches!(l.source, LodSource::Meshopt { .. }))
+        .filter_map(|(l, _)| match l.source {
+            LodSource::Meshopt { step, .. } => Some(step),
+            LodSource::File(_) => None,
+        })
+        .max();
+    let mut chain: Vec<(Mesh, f64)> = Vec::new();
+    for (lod, &want) in asset.lods.iter().zip(wanted) {
+        let (mesh, source, error) = match &lod.source {
+            LodSource::File(path) => {
+                if !want {
+                    continue;
+                }
+                (
+                    mesh::load(path, &LoadOptions::default())?,
+                    path.display().to_string(),
+                    None,
+                )
+            }
+            LodSource::Meshopt { step, target } => {
+                if last_generated.is_none_or(|last| *step > last) {
+                    continue;
+                }
+                let (input, accumulated) = match chain.last() {
+                    Some((m, e)) => (m, *e),
+                    None => (original, 0.0),
+                };
+                let s = meshopt::simplify(input, target.target(original.triangle_count()))?;
+                let error = accumulated + s.absolute_error as f64;
+                chain.push((s.mesh.clone(), error));
+                if !want {
+                    continue;
+                }
+                let what = match target {
+                    GenTarget::Ratio(r) => format!("meshopt ratio {r} (chain step {})", step + 1),
+                    GenTarget::Error(e) => format!("meshopt error {e} (chain step {})", step + 1),
+                };
+                (s.mesh, what, Some(round7(error)))
+            }
+        };
+        let info = LodInfo {
+            asset: asset.name.clone(),
+            lod: lod.name.clone(),
+            triangles: mesh.triangle_count(),
+            original_triangles: original.triangle_count(),
+            source,
+            meshopt_error: error,
+            switch_m: lod.switch_m,
+        };
+        out.push((lod.name.clone(), mesh, info));
+    }
+    Ok(out)
+}
+
+/// Views of one LOD, worst first, by the first configured metric with a per-view value (FLIP if
+/// configured); ties keep view order.
+pub fn worst_first(
+    results: &Results,
+    asset: &str,
+    lod: &str,
+    families: &[MetricFamily],
+) -> Vec<usize> {
+    let metric = if families.contains(&MetricFamily::Flip) {
+        "flip"
+    } else if families.contains(&MetricFamily::Vdp) {
+        "vdp"
+    } else if families.contains(&MetricFamily::Ssim) {
+        "ssim"
+    } else if families.contains(&MetricFamily::Psnr) {
+        "psnr"
+    } else {
+        "msssim"
+    };
+    let mut views: Vec<(usize, f64)> = results
+        .rows
+        .iter()
+        .filter(|r| r.asset == asset && r.lod == lod && r.metric == metric)
+        .map(|r| (r.view, r.value))
+        .collect();
+    let sign = if higher_is_worse(metric) { -1.0 } else { 1.0 };
+    views.sort_by(|a, b| (sign * a.1).total_cmp(&(sign * b.1)).then(a.0.cmp(&b.0)));
+    views.into_iter().map(|v| v.0).collect()
+}
+
+/// `heatmaps/ASSET/LOD/VV-METRIC.png`.
+pub fn heat_map_path(out: &Path, asset: &str, lod: &str, view: usize, metric: &str) -> PathBuf {
+    out.join("heatmaps")
+        .join(asset)
+        .join(lod)
+        .join(format!("{view:02}-{metric}.png"))
+}
+
+fn write_heat_map(
+    out: &Path,
+    asset: &str,
+    lod: &str,
+    view: usize,
+    metric: &str,
+    map: &crate::metric::ErrorMap,
+) -> Result<()> {
+    let img = colormap::heat_map(&map.values, map.width, map.height, (map.height / 32).max(4));
+    crate::io::write_image(
+        &heat_map_path(out, asset, lod, view, metric),
+        &image::DynamicImage::ImageRgb8(img),
+    )
+}
+
+fn thumbnail(img: &image::RgbImage) -> image::RgbImage {
+    if img.width() <= THUMB && img.height() <= THUMB {
+        return img.clone();
+    }
+    image::imageops::resize(img, THUMB, THUMB, image::imageops::FilterType::Triangle)
+}
+
+fn progress_bar(enabled: bool, len: u64) -> indicatif::ProgressBar {
+    if !enabled {
+        return indicatif::ProgressBar::hidden();
+    }
+    let bar = indicatif::ProgressBar::new(len);
+    if let Ok(style) = indicatif::ProgressStyle::with_template(
+        "{spinner} [{elapsed_precise}] {bar:40} {pos}/{len} renders  {msg}",
+    ) {
+        bar.set_style(style);
+    }
+    bar
+}

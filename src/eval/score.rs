@@ -1,0 +1,135 @@
+//! Scoring one rendered view pair with the configured metric families: the reference (the
+//! original's render) is prepared once per view and compared with every LOD's render.
+//!
+//! Metric names written to `metrics.csv`:
+//! `flip` (FLIP mean), `flip_p95` (95th percentile of the per-pixel FLIP map), `flip_share` (share
+//! of pixels whose FLIP exceeds `flip_pixel_threshold`), `ssim`, `msssim` (sRGB luma, Wang et al.),
+//! `psnr` (dB) and `mse` (linear luminance), `vdp` (detection probability) and `vdp_jnd`.
+
+use super::config::MetricFamily;
+use super::tables::round7;
+use crate::error::Result;
+use crate::metric::flip::{Flip, FlipPrepared};
+use crate::metric::vdp::{Display, Vdp, VdpPrepared};
+use crate::metric::{ErrorMap, LinearImage, mse, pool, ssim};
+use crate::scene::Viewing;
+
+/// The configured metrics at one viewing condition.
+#[derive(Debug, Clone)]
+pub struct Scorer {
+    families: Vec<MetricFamily>,
+    flip: Flip,
+    vdp: Vdp,
+    flip_pixel: f32,
+}
+
+/// A reference image and its prepared forms.
+#[derive(Debug)]
+pub struct Reference {
+    image: LinearImage,
+    flip: Option<FlipPrepared>,
+    vdp: Option<VdpPrepared>,
+}
+
+/// Scores of one pair: values in metric-name order, and the error maps worth drawing.
+#[derive(Debug, Clone, Default)]
+pub struct Scored {
+    /// (metric, value), rounded to 7 significant digits.
+    pub values: Vec<(&'static str, f64)>,
+    /// (metric, per-pixel map in [0, 1] where larger is worse).
+    pub maps: Vec<(&'static str, ErrorMap)>,
+}
+
+impl Scored {
+    /// A value by metric name.
+    pub fn get(&self, metric: &str) -> Option<f64> {
+        self.values.iter().find(|v| v.0 == metric).map(|v| v.1)
+    }
+}
+
+impl Scorer {
+    /// Metrics `families` at `viewing`; `flip_pixel` is the per-pixel FLIP level for `flip_share`.
+    pub fn new(families: &[MetricFamily], viewing: &Viewing, flip_pixel: f64) -> Scorer {
+        let mut families = families.to_vec();
+        families.sort();
+        families.dedup();
+        Scorer {
+            families,
+            flip: Flip::new(viewing.ppd() as f32),
+            vdp: Vdp::new(viewing, Display::DEFAULT),
+            flip_pixel: flip_pixel as f32,
+        }
+    }
+
+    fn has(&self, f: MetricFamily) -> bool {
+        self.families.contains(&f)
+    }
+
+    /// Prepare a reference image.
+    pub fn prepare(&self, image: LinearImage) -> Reference {
+        Reference {
+            flip: self
+                .has(MetricFamily::Flip)
+                .then(|| self.flip.prepare(&image)),
+            vdp: self
+                .has(MetricFamily::Vdp)
+                .then(|| self.vdp.prepare(&image)),
+            image,
+        }
+    }
+
+    /// Score `test` against a prepared reference.
+    pub fn score(&self, reference: &Reference, test: &LinearImage) -> Result<Scored> {
+        let mut out = Scored::default();
+        for &family in &self.families {
+            match family {
+                MetricFamily::Flip => {
+                    let prepared = reference.flip.as_ref().expect("prepared with FLIP");
+                    let s = self
+                        .flip
+                        .compare_prepared(prepared, &self.flip.prepare(test))?;
+                    let v = &s.map.values;
+                    let over = v.iter().filter(|&&e| e > self.flip_pixel).count();
+                    out.values.push(("flip", round7(s.mean)));
+                    out.values
+                        .push(("flip_p95", round7(pool::percentile(v, 95.0))));
+                    out.values
+                        .push(("flip_share", round7(over as f64 / v.len().max(1) as f64)));
+                    out.maps.push(("flip", s.map));
+                }
+                MetricFamily::Ssim => {
+                    let (mean, map) =
+                        ssim::ssim(&reference.image, test, ssim::SsimInput::SrgbLuma)?;
+                    out.values.push(("ssim", round7(mean)));
+                    out.maps.push((
+                        "ssim",
+                        ErrorMap {
+                            width: test.width(),
+                            height: test.height(),
+                            values: map.iter().map(|s| (1.0 - s).clamp(0.0, 1.0)).collect(),
+                        },
+                    ));
+                }
+                MetricFamily::Msssim => {
+                    let v = ssim::ms_ssim(&reference.image, test, ssim::SsimInput::SrgbLuma)?;
+                    out.values.push(("msssim", round7(v)));
+                }
+                MetricFamily::Psnr => {
+                    let s = mse::mse(&reference.image, test)?;
+                    out.values.push(("psnr", round7(s.psnr_db)));
+                    out.values.push(("mse", round7(s.mse)));
+                }
+                MetricFamily::Vdp => {
+                    let prepared = reference.vdp.as_ref().expect("prepared with VDP");
+                    let s = self
+                        .vdp
+                        .compare_prepared(prepared, &self.vdp.prepare(test))?;
+                    out.values.push(("vdp", round7(s.probability)));
+                    out.values.push(("vdp_jnd", round7(s.jnd)));
+                    out.maps.push(("vdp", s.map));
+                }
+            }
+        }
+        Ok(out)
+    }
+}

@@ -1,0 +1,465 @@
+//! The rows a run produces and the CSV files of DESIGN.md that hold them: `metrics.csv`,
+//! `summary.csv`, `distances.csv` (schemas fixed; columns are only ever added at the end), plus
+//! `lods.csv`, the per-LOD facts a merge needs.
+//!
+//! Decisions:
+//! - Every value is rounded to 7 significant digits when it is produced, and written in Rust's
+//!   shortest round-trip form, so reading a CSV back gives exactly the numbers that were written,
+//!   and a summary recomputed from merged shards equals the one a single machine writes.
+//! - Summary statistics over views are literal: `mean`, `p95` (95th percentile, linear
+//!   interpolation) and `max` of the per-view values. `worst_view` is the view with the worst value
+//!   in the metric's own direction (lowest for SSIM, MS-SSIM and PSNR, highest otherwise).
+//! - Rows are sorted by (asset, LOD, view, metric) in plan order before writing, never in the
+//!   order work finished.
+
+use std::path::Path;
+
+use serde::{Deserialize, Serialize};
+
+use crate::error::{Error, Result};
+
+/// One image pair and metric.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct MetricRow {
+    /// Asset name.
+    pub asset: String,
+    /// LOD name.
+    pub lod: String,
+    /// LOD triangles.
+    pub triangles: usize,
+    /// View number in the rig.
+    pub view: usize,
+    /// Metric name (`flip`, `flip_p95`, `flip_share`, `ssim`, `msssim`, `psnr`, `mse`, `vdp`,
+    /// `vdp_jnd`).
+    pub metric: String,
+    /// Its value.
+    pub value: f64,
+}
+
+/// What is known about one LOD besides its scores.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct LodInfo {
+    /// Asset name.
+    pub asset: String,
+    /// LOD name.
+    pub lod: String,
+    /// LOD triangles.
+    pub triangles: usize,
+    /// The original's triangles.
+    pub original_triangles: usize,
+    /// Where the LOD came from (file path or generator step).
+    pub source: String,
+    /// meshoptimizer's error estimate in model units, for generated LODs (accumulated along the
+    /// chain).
+    pub meshopt_error: Option<f64>,
+    /// The engine's switch distance from the config, metres.
+    pub switch_m: Option<f64>,
+}
+
+/// One imperceptibility distance.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct DistanceRow {
+    /// Asset name.
+    pub asset: String,
+    /// LOD name.
+    pub lod: String,
+    /// LOD triangles.
+    pub triangles: usize,
+    /// `vdp_p<level>` or `flip_mean<level>`.
+    pub criterion: String,
+    /// Nearest distance (metres, viewer to bounding-sphere centre) beyond which the LOD is
+    /// imperceptible by the criterion.
+    pub imperceptible_beyond_m: f64,
+    /// Bounding-sphere diameter over display height at that distance (Unity's LODGroup relative
+    /// screen height).
+    pub screen_height_fraction: f64,
+    /// Unreal Engine's `ScreenSize` at that distance.
+    pub unreal_screen_size: f64,
+    /// Share of the screen area the bounding sphere covers (glTF `MSFT_lod` screen coverage).
+    pub screen_coverage: f64,
+    /// meshoptimizer's error projected to display pixels at that distance, where known.
+    pub pixel_error: Option<f64>,
+    /// On-screen bounding-sphere diameter at that distance, display pixels.
+    pub diameter_px: f64,
+    /// False when the search hit a limit, so the distance is a bound: visible even at the smallest
+    /// probe (4 px; the true distance is larger), or invisible up to `max_diameter_px` (the LOD may
+    /// also be imperceptible nearer).
+    pub resolved: bool,
+}
+
+/// One line of `summary.csv`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct SummaryRow {
+    /// Asset name.
+    pub asset: String,
+    /// LOD name.
+    pub lod: String,
+    /// LOD triangles.
+    pub triangles: usize,
+    /// LOD triangles over the original's.
+    pub triangle_ratio: f64,
+    /// Metric name.
+    pub metric: String,
+    /// Mean over views.
+    pub mean: f64,
+    /// 95th percentile over views.
+    pub p95: f64,
+    /// Maximum over views.
+    pub max: f64,
+    /// The view with the worst value.
+    pub worst_view: usize,
+}
+
+/// Everything a run (or a merge of shards) produced.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Results {
+    /// Per view and metric.
+    pub rows: Vec<MetricRow>,
+    /// Per LOD.
+    pub lods: Vec<LodInfo>,
+    /// Per LOD and criterion.
+    pub distances: Vec<DistanceRow>,
+}
+
+/// Whether larger values of `metric` mean a larger difference.
+pub fn higher_is_worse(metric: &str) -> bool {
+    !matches!(metric, "ssim" | "msssim" | "psnr")
+}
+
+/// Round to 7 significant digits (see the module comment).
+pub fn round7(v: f64) -> f64 {
+    if !v.is_finite() || v == 0.0 {
+        return v;
+    }
+    format!("{v:.6e}").parse().unwrap_or(v)
+}
+
+impl Results {
+    /// Sort every table into plan order: `order` lists case ids (`ASSET/LOD`) in plan order.
+    pub fn sort(&mut self, order: &[String]) {
+        let pos = |a: &str, l: &str| {
+            order
+                .iter()
+                .position(|c| *c == super::plan::case_id(a, l))
+                .unwrap_or(usize::MAX)
+        };
+        self.rows.sort_by(|x, y| {
+            (
+                pos(&x.asset, &x.lod),
+                x.view,
+                metric_rank(&x.metric),
+                &x.metric,
+            )
+                .cmp(&(
+                    pos(&y.asset, &y.lod),
+                    y.view,
+                    metric_rank(&y.metric),
+                    &y.metric,
+                ))
+        });
+        self.lods.sort_by_key(|l| pos(&l.asset, &l.lod));
+        self.distances.sort_by(|x, y| {
+            (pos(&x.asset, &x.lod), &x.criterion).cmp(&(pos(&y.asset, &y.lod), &y.criterion))
+        });
+    }
+
+    /// Per (asset, LOD, metric) statistics over views, in row order.
+    pub fn summary(&self) -> Vec<SummaryRow> {
+        let mut out: Vec<SummaryRow> = Vec::new();
+        type Key = (String, String, String);
+        let mut groups: Vec<(Key, Vec<(usize, f64)>)> = Vec::new();
+        for r in &self.rows {
+            let key = (r.asset.clone(), r.lod.clone(), r.metric.clone());
+            match groups.iter_mut().find(|(k, _)| *k == key) {
+                Some((_, v)) => v.push((r.view, r.value)),
+                None => groups.push((key, vec![(r.view, r.value)])),
+            }
+        }
+        for ((asset, lod, metric), values) in groups {
+            let info = self.lods.iter().find(|l| l.asset == asset && l.lod == lod);
+            let (triangles, ratio) = info.map_or((0, 0.0), |l| {
+                (
+                    l.triangles,
+                    l.triangles as f64 / l.original_triangles.max(1) as f64,
+                )
+            });
+            let vals: Vec<f64> = values.iter().map(|v| v.1).collect();
+            let worse = higher_is_worse(&metric);
+            let worst_view = values
+                .iter()
+                .fold(None::<(usize, f64)>, |best, &(view, v)| match best {
+                    Some((_, b)) if (worse && v <= b) || (!worse && v >= b) => best,
+                    _ => Some((view, v)),
+                })
+                .map_or(0, |b| b.0);
+            out.push(SummaryRow {
+                asset,
+                lod,
+                triangles,
+                triangle_ratio: round7(ratio),
+                metric,
+                mean: round7(vals.iter().sum::<f64>() / vals.len() as f64),
+                p95: round7(percentile(&vals, 95.0)),
+                max: vals.iter().copied().fold(f64::NEG_INFINITY, f64::max),
+                worst_view,
+            });
+        }
+        out
+    }
+
+    /// The worst per-view value of `metric` for one LOD, in the metric's direction.
+    pub fn worst(&self, asset: &str, lod: &str, metric: &str) -> Option<(usize, f64)> {
+        let worse = higher_is_worse(metric);
+        self.rows
+            .iter()
+            .filter(|r| r.asset == asset && r.lod == lod && r.metric == metric)
+            .fold(None, |best: Option<(usize, f64)>, r| match best {
+                Some((_, b)) if (worse && r.value <= b) || (!worse && r.value >= b) => best,
+                _ => Some((r.view, r.value)),
+            })
+    }
+
+    /// The mean over views of `metric` for one LOD.
+    pub fn mean(&self, asset: &str, lod: &str, metric: &str) -> Option<f64> {
+        let v: Vec<f64> = self
+            .rows
+            .iter()
+            .filter(|r| r.asset == asset && r.lod == lod && r.metric == metric)
+            .map(|r| r.value)
+            .collect();
+        (!v.is_empty()).then(|| round7(v.iter().sum::<f64>() / v.len() as f64))
+    }
+
+    /// Write `metrics.csv`, `summary.csv`, `distances.csv` and `lods.csv` into `dir`.
+    pub fn write_csvs(&self, dir: &Path) -> Result<()> {
+        write_csv(&dir.join("metrics.csv"), &self.rows)?;
+        write_csv(&dir.join("summary.csv"), &self.summary())?;
+        write_csv(&dir.join("distances.csv"), &self.distances)?;
+        write_csv(&dir.join("lods.csv"), &self.lods)
+    }
+
+    /// Read the tables a run wrote into `dir` (for `merge`).
+    pub fn read_csvs(dir: &Path) -> Result<Results> {
+        Ok(Results {
+            rows: read_csv(&dir.join("metrics.csv"))?,
+            lods: read_csv(&dir.join("lods.csv"))?,
+            distances: read_csv(&dir.join("distances.csv"))?,
+        })
+    }
+}
+
+fn metric_rank(m: &str) -> usize {
+    const ORDER: [&str; 9] = [
+        "flip",
+        "flip_p95",
+        "flip_share",
+        "ssim",
+        "msssim",
+        "psnr",
+        "mse",
+        "vdp",
+        "vdp_jnd",
+    ];
+    ORDER.iter().position(|o| *o == m).unwrap_or(ORDER.len())
+}
+
+/// Linear-interpolation percentile (NumPy's default) of unsorted values.
+pub fn percentile(values: &[f64], p: f64) -> f64 {
+    if values.is_empty() {
+        return f64::NAN;
+    }
+    let mut s = values.to_vec();
+    s.sort_by(f64::total_cmp);
+    let rank = p.clamp(0.0, 100.0) / 100.0 * (s.len() - 1) as f64;
+    let (lo, hi) = (rank.floor() as usize, rank.ceil() as usize);
+    if lo == hi || s[lo] == s[hi] {
+        return s[lo];
+    }
+    s[lo] + (s[hi] - s[lo]) * (rank - lo as f64)
+}
+
+/// A table row type and its CSV header (DESIGN.md's schema; the serde field order must match).
+pub trait Columns {
+    /// Column names in order.
+    const COLUMNS: &'static [&'static str];
+}
+
+impl Columns for MetricRow {
+    const COLUMNS: &'static [&'static str] =
+        &["asset", "lod", "triangles", "view", "metric", "value"];
+}
+
+impl Columns for SummaryRow {
+    const COLUMNS: &'static [&'static str] = &[
+        "asset",
+        "lod",
+        "triangles",
+        "triangle_ratio",
+        "metric",
+        "mean",
+        "p95",
+        "max",
+        "worst_view",
+    ];
+}
+
+impl Columns for DistanceRow {
+    const COLUMNS: &'static [&'static str] = &[
+        "asset",
+        "lod",
+        "triangles",
+        "criterion",
+        "imperceptible_beyond_m",
+        "screen_height_fraction",
+        "unreal_screen_size",
+        "screen_coverage",
+        "pixel_error",
+        "diameter_px",
+        "resolved",
+    ];
+}
+
+impl Columns for LodInfo {
+    const COLUMNS: &'static [&'static str] = &[
+        "asset",
+        "lod",
+        "triangles",
+        "original_triangles",
+        "source",
+        "meshopt_error",
+        "switch_m",
+    ];
+}
+
+/// Write rows as CSV with a header (also for an empty table), atomically.
+pub fn write_csv<T: Serialize + Columns>(path: &Path, rows: &[T]) -> Result<()> {
+    let mut w = ::csv::WriterBuilder::new()
+        .has_headers(false)
+        .from_writer(Vec::new());
+    let fail =
+        |e: &dyn std::fmt::Display| Error::Internal(format!("writing {}: {e}", path.display()));
+    w.write_record(T::COLUMNS).map_err(|e| fail(&e))?;
+    for r in rows {
+        w.serialize(r).map_err(|e| fail(&e))?;
+    }
+    let bytes = w.into_inner().map_err(|e| fail(&e))?;
+    crate::io::write_atomic(path, &bytes)
+}
+
+/// Read a CSV written by [`write_csv`].
+pub fn read_csv<T: for<'de> Deserialize<'de>>(path: &Path) -> Result<Vec<T>> {
+    let mut r = ::csv::Reader::from_path(path).map_err(|e| {
+        Error::input(
+            path,
+            format!("cannot read: {e}"),
+            "give the output folder of an `lodeval eval` run",
+        )
+    })?;
+    r.deserialize()
+        .enumerate()
+        .map(|(i, row)| {
+            row.map_err(|e| {
+                Error::input_at(
+                    path,
+                    crate::error::Location::Line(i + 2),
+                    format!("is not an lodeval table: {e}"),
+                    "give the output folder of an `lodeval eval` run",
+                )
+            })
+        })
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn row(lod: &str, view: usize, metric: &str, value: f64) -> MetricRow {
+        MetricRow {
+            asset: "a".into(),
+            lod: lod.into(),
+            triangles: 10,
+            view,
+            metric: metric.into(),
+            value,
+        }
+    }
+
+    #[test]
+    fn summary_statistics_and_worst_view_direction() {
+        let mut r = Results::default();
+        for (v, f, s) in [(0, 0.1, 0.9), (1, 0.3, 0.7), (2, 0.2, 0.95)] {
+            r.rows.push(row("l", v, "flip", f));
+            r.rows.push(row("l", v, "ssim", s));
+        }
+        let s = r.summary();
+        let flip = s.iter().find(|x| x.metric == "flip").unwrap();
+        assert_eq!((flip.worst_view, flip.max), (1, 0.3));
+        assert!((flip.mean - 0.2).abs() < 1e-12);
+        assert!((flip.p95 - 0.29).abs() < 1e-12);
+        let ssim = s.iter().find(|x| x.metric == "ssim").unwrap();
+        assert_eq!(ssim.worst_view, 1);
+    }
+
+    #[test]
+    fn csv_round_trip_is_exact() {
+        let dir = tempfile::tempdir().unwrap();
+        let mut r = Results::default();
+        for (i, v) in [0.1234567, 1e-9, f64::INFINITY, 42.0].iter().enumerate() {
+            r.rows.push(row("l", i, "psnr", round7(*v)));
+        }
+        r.write_csvs(dir.path()).unwrap();
+        let back = Results::read_csvs(dir.path()).unwrap();
+        assert_eq!(back.rows, r.rows);
+        let text = std::fs::read_to_string(dir.path().join("metrics.csv")).unwrap();
+        assert!(
+            text.starts_with("asset,lod,triangles,view,metric,value\n"),
+            "{text}"
+        );
+        let d = std::fs::read_to_string(dir.path().join("distances.csv")).unwrap();
+        assert!(d.starts_with(
+            "asset,lod,triangles,criterion,imperceptible_beyond_m,screen_height_fraction,"
+        ));
+    }
+
+    #[test]
+    fn columns_match_serde_field_order() {
+        fn header<T: Serialize + Columns>(row: T) {
+            let mut w = ::csv::Writer::from_writer(Vec::new());
+            w.serialize(row).unwrap();
+            let text = String::from_utf8(w.into_inner().unwrap()).unwrap();
+            assert_eq!(text.lines().next().unwrap(), T::COLUMNS.join(","));
+        }
+        header(row("l", 0, "flip", 0.1));
+        header(
+            Results {
+                rows: vec![row("l", 0, "flip", 0.1)],
+                ..Default::default()
+            }
+            .summary()
+            .remove(0),
+        );
+        header(LodInfo {
+            asset: "a".into(),
+            lod: "l".into(),
+            triangles: 1,
+            original_triangles: 2,
+            source: "s".into(),
+            meshopt_error: None,
+            switch_m: None,
+        });
+        header(DistanceRow {
+            asset: "a".into(),
+            lod: "l".into(),
+            triangles: 1,
+            criterion: "c".into(),
+            imperceptible_beyond_m: 1.0,
+            screen_height_fraction: 0.1,
+            unreal_screen_size: 0.1,
+            screen_coverage: 0.1,
+            pixel_error: None,
+            diameter_px: 1.0,
+            resolved: true,
+        });
+    }
+}
