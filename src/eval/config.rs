@@ -535,7 +535,18 @@ impl Config {
             let line = e
                 .span()
                 .map(|s| text[..s.start.min(text.len())].matches('\n').count() + 1);
-            let problem = e.message().trim().to_string();
+            let mut problem = e.message().trim().to_string();
+            // Name the key: toml's type errors give the span of the value but not the key.
+            if let Some(start) = e.span().map(|s| s.start.min(text.len())) {
+                let line_start = text[..start].rfind('\n').map_or(0, |i| i + 1);
+                let line_text = text[line_start..].lines().next().unwrap_or("");
+                if let Some((key, _)) = line_text.split_once('=') {
+                    let key = key.trim();
+                    if !key.is_empty() && !problem.contains(key) {
+                        problem = format!("`{key}`: {problem}");
+                    }
+                }
+            }
             let fix = "see configs/README.md for every key, its type and its default";
             match line {
                 Some(l) => Error::input_at(path, Location::Line(l), problem, fix),

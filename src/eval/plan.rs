@@ -271,11 +271,17 @@ impl Shard {
     }
 }
 
-/// 64-bit FNV-1a.
+/// 64-bit FNV-1a, finished with MurmurHash3's fmix64: FNV's low bits alone are the parity of
+/// the bytes' low bits, so `% 2` would put most ids into one shard.
 fn fnv1a(bytes: &[u8]) -> u64 {
-    bytes.iter().fold(0xcbf2_9ce4_8422_2325, |h, &b| {
+    let mut h = bytes.iter().fold(0xcbf2_9ce4_8422_2325u64, |h, &b| {
         (h ^ b as u64).wrapping_mul(0x0100_0000_01b3)
-    })
+    });
+    h ^= h >> 33;
+    h = h.wrapping_mul(0xff51_afd7_ed55_8ccd);
+    h ^= h >> 33;
+    h = h.wrapping_mul(0xc4ce_b9fe_1a85_ec53);
+    h ^ (h >> 33)
 }
 
 #[cfg(test)]
@@ -322,6 +328,10 @@ lods = [{ mesh = "a1.obj", thresholds = { psnr_min = 30.0 } }, { mesh = "a2.obj"
             }
             assert_eq!(seen, ids.len());
         }
+        // Both halves get a fair share (FNV's raw low bit would not).
+        let half = Shard { index: 0, count: 2 };
+        let n = ids.iter().filter(|c| half.contains(c)).count();
+        assert!((70..=130).contains(&n), "{n} of 200 in shard 0/2");
         assert!(Shard::parse("2/2").is_err() && Shard::parse("x").is_err());
         assert_eq!(Shard::parse("1/3").unwrap(), Shard { index: 1, count: 3 });
         let env = |k: &str| match k {

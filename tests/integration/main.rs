@@ -5,6 +5,8 @@
 //!   the file and the problem, and never panic.
 //! - `models`: `lodeval info` on every model of the shared collection against MANIFEST.md's counts
 //!   (skipped only when `../shared` is absent) and on the shipped `reference/models`.
+//! - `eval`: the batch evaluator (determinism, shards, gate, golden images, bad configs, LOD
+//!   chains on every shipped model).
 //! - `fuzz`: property-based mutation fuzzing of the OBJ, PLY, OFF and GLB paths.
 //! - `oracles`: metrics against reference implementations (FLIP: NVIDIA's; SSIM/PSNR: scikit-image).
 //! - `raster`: the CPU rasterizer (determinism over thread counts, watertightness, golden images,
@@ -14,6 +16,7 @@
 mod bad_input;
 mod cli;
 mod common;
+mod eval;
 mod fuzz;
 mod models;
 mod oracles;

@@ -1,0 +1,465 @@
+//! The batch evaluator end to end: determinism over thread counts, shards merged equal one run,
+//! the gate (thresholds, broken LODs, baselines, switch distances), golden images, bad configs, and
+//! monotone scores and distances along the LOD chain of every shipped model.
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+use crate::common::{Run, lodeval, model};
+
+/// Run the CLI with `CI` set or removed.
+fn lodeval_ci(args: &[&str], ci: bool) -> Run {
+    let mut cmd = Command::new(env!("CARGO_BIN_EXE_lodeval"));
+    cmd.args(args).env_remove("RUST_BACKTRACE");
+    if ci {
+        cmd.env("CI", "true");
+    } else {
+        cmd.env_remove("CI");
+    }
+    let out = cmd.output().expect("the lodeval binary runs");
+    Run {
+        code: out.status.code().unwrap_or(-1),
+        stdout: String::from_utf8_lossy(&out.stdout).into_owned(),
+        stderr: String::from_utf8_lossy(&out.stderr).into_owned(),
+    }
+}
+
+/// A config in `dir` with small renders; `assets` is TOML for the `[[asset]]` entries.
+fn config(dir: &Path, extra: &str, assets: &str) -> PathBuf {
+    let text = format!(
+        "out = \"out\"\nmetrics = [\"flip\", \"ssim\", \"psnr\", \"vdp\"]\n[render]\nsize = 64\nrig = \"icosahedron\"\n[distance]\nviews = 1\nmax_diameter_px = 64\n{extra}\n{assets}"
+    );
+    let path = dir.join("c.toml");
+    std::fs::write(&path, text).unwrap();
+    path
+}
+
+fn asset(name: &str, mesh: &Path, rest: &str) -> String {
+    format!(
+        "[[asset]]\nname = \"{name}\"\nmesh = \"{}\"\n{rest}\n",
+        mesh.display()
+    )
+}
+
+/// Every file under `dir` (relative path → bytes).
+fn files(dir: &Path) -> BTreeMap<PathBuf, Vec<u8>> {
+    let mut out = BTreeMap::new();
+    let mut stack = vec![dir.to_path_buf()];
+    while let Some(d) = stack.pop() {
+        for e in std::fs::read_dir(&d).unwrap() {
+            let p = e.unwrap().path();
+            if p.is_dir() {
+                stack.push(p);
+            } else {
+                out.insert(
+                    p.strip_prefix(dir).unwrap().to_path_buf(),
+                    std::fs::read(&p).unwrap(),
+                );
+            }
+        }
+    }
+    out
+}
+
+fn assert_same_tree(a: &Path, b: &Path) {
+    let (fa, fb) = (files(a), files(b));
+    assert_eq!(
+        fa.keys().collect::<Vec<_>>(),
+        fb.keys().collect::<Vec<_>>(),
+        "{} vs {}",
+        a.display(),
+        b.display()
+    );
+    for (k, v) in &fa {
+        assert!(
+            *v == fb[k],
+            "{} differs between {} and {}",
+            k.display(),
+            a.display(),
+            b.display()
+        );
+    }
+}
+
+const CHAIN: &str = "generate = { method = \"meshopt\", ratios = [0.5, 0.25] }";
+
+#[test]
+fn outputs_are_identical_for_any_thread_count_and_merged_shards_equal_one_run() {
+    let dir = tempfile::tempdir().unwrap();
+    let assets = asset("bunny3k", &model("bunny/bunny_odedstein_3k.obj"), CHAIN)
+        + &asset("spot", &model("spot/spot_mtl.obj"), CHAIN);
+    let cfg = config(dir.path(), "", &assets);
+    let c = cfg.to_str().unwrap();
+    let out = |name: &str| dir.path().join(name);
+    for t in ["1", "2", "8"] {
+        let o = out(&format!("t{t}"));
+        let r = lodeval(["eval", c, "--threads", t, "--out", o.to_str().unwrap()]);
+        assert_eq!(r.code, 0, "{}", r.stderr);
+    }
+    assert_same_tree(&out("t1"), &out("t2"));
+    assert_same_tree(&out("t1"), &out("t8"));
+    let t1 = files(&out("t1"));
+    for f in [
+        "metrics.csv",
+        "summary.csv",
+        "distances.csv",
+        "junit.xml",
+        "report.html",
+    ] {
+        assert!(t1.contains_key(Path::new(f)), "{f} missing");
+    }
+    assert!(t1.contains_key(Path::new("heatmaps/spot/meshopt-r25/11-flip.png")));
+    assert!(t1.contains_key(Path::new("sheets/bunny3k/meshopt-r50.png")));
+    let metrics = String::from_utf8(t1[Path::new("metrics.csv")].clone()).unwrap();
+    // 2 assets × 2 LODs × 12 views × (flip, flip_p95, flip_share, ssim, psnr, mse, vdp, vdp_jnd).
+    assert_eq!(metrics.lines().count(), 1 + 2 * 2 * 12 * 8);
+    // Two shards, merged, equal the single run byte for byte; each shard has work.
+    for s in ["0/2", "1/2"] {
+        let o = out(&format!("shard{}", &s[..1]));
+        let r = lodeval(["eval", c, "--shard", s, "--out", o.to_str().unwrap()]);
+        assert_eq!(r.code, 0, "{}", r.stderr);
+        let m = std::fs::read_to_string(o.join("shard.json")).unwrap();
+        assert!(m.contains("meshopt-r"), "shard {s} got no case: {m}");
+    }
+    let merged = out("merged");
+    let r = lodeval([
+        "merge",
+        out("shard0").to_str().unwrap(),
+        out("shard1").to_str().unwrap(),
+        "--out",
+        merged.to_str().unwrap(),
+    ]);
+    assert_eq!(r.code, 0, "{}", r.stderr);
+    assert_same_tree(&out("t1"), &merged);
+    // A missing shard or a shard given twice is an error.
+    let r = lodeval([
+        "merge",
+        out("shard0").to_str().unwrap(),
+        "--out",
+        out("m2").to_str().unwrap(),
+    ]);
+    assert_eq!(r.code, 2, "{}", r.stderr);
+    assert!(r.stderr.contains("in no shard"), "{}", r.stderr);
+    let r = lodeval([
+        "merge",
+        out("shard0").to_str().unwrap(),
+        out("shard0").to_str().unwrap(),
+        out("shard1").to_str().unwrap(),
+        "--out",
+        out("m3").to_str().unwrap(),
+    ]);
+    assert_eq!(r.code, 2, "{}", r.stderr);
+    assert!(r.stderr.contains("also in"), "{}", r.stderr);
+}
+
+/// Rewrite an OBJ line by line.
+fn edit_obj(src: &Path, dst: &Path, f: impl Fn(&str, &[glam::Vec3]) -> Option<String>) {
+    let text = std::fs::read_to_string(src).unwrap();
+    let mut verts = Vec::new();
+    let mut out = String::new();
+    for line in text.lines() {
+        if let Some(rest) = line.strip_prefix("v ") {
+            let v: Vec<f32> = rest
+                .split_whitespace()
+                .map(|x| x.parse().unwrap())
+                .collect();
+            verts.push(glam::Vec3::new(v[0], v[1], v[2]));
+        }
+        if let Some(l) = f(line, &verts) {
+            out.push_str(&l);
+            out.push('\n');
+        }
+    }
+    std::fs::write(dst, out).unwrap();
+}
+
+#[test]
+fn gate_passes_good_lods_and_names_broken_ones() {
+    let dir = tempfile::tempdir().unwrap();
+    let src = model("bunny/bunny_odedstein_3k.obj");
+    // A hole: faces whose first vertex lies in the +x third of the bunny are dropped.
+    let holey = dir.path().join("holey.obj");
+    edit_obj(&src, &holey, |line, verts| {
+        if let Some(rest) = line.strip_prefix("f ") {
+            let first: usize = rest.split('/').next().unwrap().trim().parse().unwrap();
+            if verts[first - 1].x > 0.3 {
+                return None;
+            }
+        }
+        Some(line.to_string())
+    });
+    // Flipped normals: every file normal negated.
+    let flipped = dir.path().join("flipped.obj");
+    edit_obj(&src, &flipped, |line, _| {
+        Some(match line.strip_prefix("vn ") {
+            Some(rest) => {
+                let n: Vec<String> = rest
+                    .split_whitespace()
+                    .map(|x| format!("{}", -x.parse::<f32>().unwrap()))
+                    .collect();
+                format!("vn {}", n.join(" "))
+            }
+            None => line.to_string(),
+        })
+    });
+    let thresholds = "[thresholds]\nflip_mean = 0.05\n";
+    let good = asset(
+        "bunny3k",
+        &src,
+        "generate = { method = \"meshopt\", ratios = [0.5] }",
+    );
+    let cfg = config(dir.path(), thresholds, &good);
+    let r = lodeval(["eval", cfg.to_str().unwrap()]);
+    assert_eq!(r.code, 0, "{}{}", r.stdout, r.stderr);
+    assert!(r.stdout.contains("meshopt-r50") && r.stdout.contains("pass"));
+
+    let lods = format!(
+        "lods = [{{ name = \"holey\", mesh = \"{}\" }}, {{ name = \"flipped\", mesh = \"{}\" }}]\ngenerate = {{ method = \"meshopt\", ratios = [0.5] }}",
+        holey.display(),
+        flipped.display()
+    );
+    let cfg = config(dir.path(), thresholds, &asset("bunny3k", &src, &lods));
+    let r = lodeval(["eval", cfg.to_str().unwrap()]);
+    assert_eq!(r.code, 1, "{}{}", r.stdout, r.stderr);
+    assert!(
+        r.stderr.contains("FAIL bunny3k/holey flip_mean"),
+        "{}",
+        r.stderr
+    );
+    assert!(
+        r.stderr.contains("FAIL bunny3k/flipped flip_mean"),
+        "{}",
+        r.stderr
+    );
+    assert!(r.stderr.contains("limit from"), "{}", r.stderr);
+    assert!(!r.stderr.contains("bunny3k/meshopt-r50"), "{}", r.stderr);
+    let junit = std::fs::read_to_string(dir.path().join("out/junit.xml")).unwrap();
+    assert!(
+        junit.contains("<failure") && junit.contains("holey"),
+        "{junit}"
+    );
+    let report = std::fs::read_to_string(dir.path().join("out/report.html")).unwrap();
+    let first_fail = report.find("FAIL bunny3k/").unwrap();
+    assert!(
+        first_fail < report.find("<table").unwrap(),
+        "failures come first"
+    );
+}
+
+#[test]
+fn baseline_regressions_and_switch_distances_fail_the_gate() {
+    let dir = tempfile::tempdir().unwrap();
+    let src = model("bunny/bunny_odedstein_3k.obj");
+    let good = asset(
+        "bunny3k",
+        &src,
+        "generate = { method = \"meshopt\", ratios = [0.5] }",
+    );
+    let cfg = config(dir.path(), "", &good);
+    assert_eq!(lodeval(["eval", cfg.to_str().unwrap()]).code, 0);
+    // A baseline whose FLIP means were half of today's: today is a regression.
+    let summary = std::fs::read_to_string(dir.path().join("out/summary.csv")).unwrap();
+    let mut base = String::new();
+    for (i, line) in summary.lines().enumerate() {
+        let mut f: Vec<String> = line.split(',').map(str::to_string).collect();
+        if i > 0 && f[4] == "flip" {
+            f[5] = format!("{}", f[5].parse::<f64>().unwrap() / 2.0);
+        }
+        base.push_str(&f.join(","));
+        base.push('\n');
+    }
+    std::fs::write(dir.path().join("baseline.csv"), base).unwrap();
+    let cfg = config(
+        dir.path(),
+        "[gate]\nbaseline = \"baseline.csv\"\ntolerance = 0.1\n",
+        &good,
+    );
+    let r = lodeval(["eval", cfg.to_str().unwrap()]);
+    assert_eq!(r.code, 1, "{}", r.stderr);
+    assert!(r.stderr.contains("baseline:flip"), "{}", r.stderr);
+    assert!(!r.stderr.contains("baseline:ssim"), "{}", r.stderr);
+    // Its own summary as the baseline passes.
+    std::fs::write(dir.path().join("baseline.csv"), summary).unwrap();
+    assert_eq!(lodeval(["eval", cfg.to_str().unwrap()]).code, 0);
+    // An engine switch distance nearer than the measured one fails, naming both distances.
+    let near = asset(
+        "bunny3k",
+        &src,
+        "generate = { method = \"meshopt\", ratios = [0.5], switch_m = [0.5] }",
+    );
+    let cfg = config(dir.path(), "", &near);
+    let r = lodeval(["eval", cfg.to_str().unwrap()]);
+    assert_eq!(r.code, 1, "{}", r.stderr);
+    assert!(
+        r.stderr.contains("is used from 0.5 m but is visible until"),
+        "{}",
+        r.stderr
+    );
+}
+
+#[test]
+fn bad_configs_exit_2_naming_the_file_key_and_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let src = model("bunny/bunny_odedstein_3k.obj");
+    let good = asset("b", &src, CHAIN);
+    for (extra, words) in [
+        ("[images]\nsise = 3\n", vec!["line 10", "sise"]),
+        (
+            "[images]\nheatmaps = \"some\"\n",
+            vec!["line 10", "some", "worst"],
+        ),
+        ("[viewing]\ndistance_m = 0.0\n", vec!["line 10", "above 0"]),
+        (
+            "[thresholds]\nflip_mean = \"low\"\n",
+            vec!["line 10", "flip_mean"],
+        ),
+    ] {
+        let cfg = config(dir.path(), extra, &good);
+        let r = lodeval(["eval", cfg.to_str().unwrap()]);
+        assert_eq!(r.code, 2, "{extra}: {}", r.stderr);
+        assert!(r.stderr.contains("c.toml"), "{}", r.stderr);
+        for w in words {
+            assert!(r.stderr.contains(w), "{extra}: {w} not in {}", r.stderr);
+        }
+        assert!(!dir.path().join("out/metrics.csv").exists());
+    }
+    // A missing mesh names the mesh file.
+    let cfg = config(
+        dir.path(),
+        "",
+        &asset("b", &dir.path().join("nope.obj"), CHAIN),
+    );
+    let r = lodeval(["eval", cfg.to_str().unwrap()]);
+    assert_eq!(r.code, 2, "{}", r.stderr);
+    assert!(r.stderr.contains("nope.obj"), "{}", r.stderr);
+    // A missing config, and a bad shard.
+    assert_eq!(lodeval(["eval", "no-such.toml"]).code, 2);
+    let cfg = config(dir.path(), "", &good);
+    let r = lodeval(["eval", cfg.to_str().unwrap(), "--shard", "2/2"]);
+    assert_eq!(r.code, 2, "{}", r.stderr);
+}
+
+#[test]
+fn golden_images_compare_mismatch_bless_and_refuse_under_ci() {
+    let dir = tempfile::tempdir().unwrap();
+    let extra = "[golden]\ndir = \"golden\"\nlods = false\n";
+    let assets = asset(
+        "bunny3k",
+        &model("bunny/bunny_odedstein_3k.obj"),
+        "generate = { method = \"meshopt\", ratios = [0.5] }",
+    );
+    let cfg = config(dir.path(), extra, &assets);
+    let c = cfg.to_str().unwrap();
+    // No goldens yet: a mismatch, with the bless command.
+    let r = lodeval_ci(&["golden", c], false);
+    assert_eq!(r.code, 1, "{}", r.stderr);
+    assert!(r.stderr.contains("no golden image"), "{}", r.stderr);
+    assert!(
+        r.stderr.contains(&format!("lodeval golden {c} --bless")),
+        "{}",
+        r.stderr
+    );
+    // Blessing is refused under CI, and writes nothing.
+    let r = lodeval_ci(&["golden", c, "--bless"], true);
+    assert_eq!(r.code, 2, "{}", r.stderr);
+    assert!(r.stderr.contains("refusing"), "{}", r.stderr);
+    assert!(!dir.path().join("golden").exists());
+    // Bless, then compare clean.
+    let r = lodeval_ci(&["golden", c, "--bless"], false);
+    assert_eq!(r.code, 0, "{}", r.stderr);
+    let golden = dir.path().join("golden/bunny3k/original/view-03.png");
+    assert!(golden.exists());
+    let r = lodeval_ci(&["golden", c], true);
+    assert_eq!(r.code, 0, "{}", r.stderr);
+    assert!(r.stdout.contains("12 image(s) match"), "{}", r.stdout);
+    // Paint a block into one golden: that view (only) mismatches, with actual and diff images.
+    let mut img = image::open(&golden).unwrap().to_rgb8();
+    for y in 20..40 {
+        for x in 20..40 {
+            img.put_pixel(x, y, image::Rgb([255, 0, 0]));
+        }
+    }
+    img.save(&golden).unwrap();
+    let r = lodeval_ci(&["golden", c], true);
+    assert_eq!(r.code, 1, "{}", r.stderr);
+    assert_eq!(r.stderr.matches("MISMATCH").count(), 1, "{}", r.stderr);
+    assert!(r.stderr.contains("view-03.png"), "{}", r.stderr);
+    let out = dir.path().join("out/golden/bunny3k/original");
+    assert!(out.join("view-03-actual.png").exists() && out.join("view-03-diff.png").exists());
+}
+
+/// Per LOD, in chain order: (FLIP mean over views, VDP imperceptibility distance).
+fn chain_scores(dir: &Path) -> Vec<(String, f64, f64)> {
+    let summary = std::fs::read_to_string(dir.join("summary.csv")).unwrap();
+    let distances = std::fs::read_to_string(dir.join("distances.csv")).unwrap();
+    summary
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').collect::<Vec<_>>())
+        .filter(|f| f[4] == "flip")
+        .map(|f| {
+            let d = distances
+                .lines()
+                .map(|l| l.split(',').collect::<Vec<_>>())
+                .find(|d| d[1] == f[1] && d[3].starts_with("vdp"))
+                .map(|d| d[4].parse::<f64>().unwrap())
+                .unwrap();
+            (f[1].to_string(), f[5].parse().unwrap(), d)
+        })
+        .collect()
+}
+
+#[test]
+fn scores_and_distances_grow_along_the_lod_chain_of_every_shipped_model() {
+    let dir = tempfile::tempdir().unwrap();
+    let chain = "generate = { method = \"meshopt\", ratios = [0.5, 0.2, 0.05] }";
+    let assets: String = [
+        ("bunny", "bunny/stanford-bunny.obj"),
+        ("bunny3k", "bunny/bunny_odedstein_3k.obj"),
+        ("spot", "spot/spot_mtl.obj"),
+        ("barrel", "barrel/barrel.glb"),
+        ("dragon", "dragon/dragon_vrip_res4.ply"),
+    ]
+    .iter()
+    .map(|(n, p)| asset(n, &model(p), chain))
+    .collect();
+    let text = format!(
+        "out = \"out\"\nmetrics = [\"flip\", \"vdp\"]\n[render]\nsize = 96\nrig = \"icosahedron\"\n[distance]\nviews = 2\nmax_diameter_px = 512\n{assets}"
+    );
+    let cfg = dir.path().join("chain.toml");
+    std::fs::write(&cfg, text).unwrap();
+    let r = lodeval(["eval", cfg.to_str().unwrap()]);
+    assert_eq!(r.code, 0, "{}", r.stderr);
+    eprintln!("{}", r.stdout);
+    let summary = std::fs::read_to_string(dir.path().join("out/summary.csv")).unwrap();
+    let all = chain_scores(&dir.path().join("out"));
+    let distances = std::fs::read_to_string(dir.path().join("out/distances.csv")).unwrap();
+    for name in ["bunny", "bunny3k", "spot", "barrel", "dragon"] {
+        let mine: Vec<&str> = summary
+            .lines()
+            .filter(|l| l.starts_with(&format!("{name},")) && l.contains(",flip,"))
+            .collect();
+        assert_eq!(mine.len(), 3, "{name}");
+        let flips: Vec<f64> = mine
+            .iter()
+            .map(|l| l.split(',').nth(5).unwrap().parse().unwrap())
+            .collect();
+        assert!(
+            flips.windows(2).all(|w| w[0] < w[1]),
+            "{name}: FLIP {flips:?}"
+        );
+        let dists: Vec<f64> = distances
+            .lines()
+            .filter(|l| l.starts_with(&format!("{name},")) && l.contains(",vdp_p"))
+            .map(|l| l.split(',').nth(4).unwrap().parse().unwrap())
+            .collect();
+        assert_eq!(dists.len(), 3, "{name}");
+        assert!(
+            dists.windows(2).all(|w| w[0] <= w[1]),
+            "{name}: distances {dists:?}"
+        );
+    }
+    assert_eq!(all.len(), 15);
+    assert!(all.iter().all(|(_, flip, d)| *flip > 0.0 && *d > 0.0));
+}
