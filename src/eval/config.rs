@@ -674,8 +674,11 @@ impl Config {
         }
         let base = config_dir(config_path);
         match &self.out {
-            Some(o) => base.join(o),
-            None => base.join("..").join("results").join(stem(config_path)),
+            Some(o) => resolve(&base, o),
+            None => resolve(
+                &base,
+                &Path::new("..").join("results").join(stem(config_path)),
+            ),
         }
     }
 }
@@ -709,6 +712,27 @@ pub fn config_dir(config_path: &Path) -> PathBuf {
         Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
         _ => PathBuf::from("."),
     }
+}
+
+/// `base` joined with `rel`, with `dir/..` pairs removed lexically (`configs/../results` →
+/// `results`), so messages show the paths a user would type. Leading `..` stay.
+pub fn resolve(base: &Path, rel: &Path) -> PathBuf {
+    use std::path::Component;
+    let joined = base.join(rel);
+    let mut out: Vec<Component> = Vec::new();
+    for c in joined.components() {
+        match c {
+            Component::CurDir => {}
+            Component::ParentDir if matches!(out.last(), Some(Component::Normal(_))) => {
+                out.pop();
+            }
+            other => out.push(other),
+        }
+    }
+    if out.is_empty() {
+        return PathBuf::from(".");
+    }
+    out.iter().collect()
 }
 
 /// The config's file stem (`demo` for `configs/demo.toml`).
@@ -772,6 +796,15 @@ mod tests {
         assert!(parse(none).unwrap_err().to_string().contains("neither"));
         let bad_t = format!("{MINIMAL}[thresholds]\nflip_mean = 2.0\n");
         assert!(parse(&bad_t).unwrap_err().to_string().contains("flip_mean"));
+    }
+
+    #[test]
+    fn paths_resolve_lexically() {
+        let r = |b: &str, p: &str| resolve(Path::new(b), Path::new(p));
+        assert_eq!(r("configs", "../results/demo"), Path::new("results/demo"));
+        assert_eq!(r(".", "../x"), Path::new("../x"));
+        assert_eq!(r("/a/b", "/abs/m.obj"), Path::new("/abs/m.obj"));
+        assert_eq!(r("a", ".."), Path::new("."));
     }
 
     #[test]

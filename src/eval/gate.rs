@@ -124,7 +124,7 @@ pub fn check(plan: &Plan, results: &Results) -> Result<Vec<Failure>> {
         }
     }
     if let Some(baseline) = &plan.config.gate.baseline {
-        let path = config_dir(&plan.config_path).join(baseline);
+        let path = super::config::resolve(&config_dir(&plan.config_path), baseline);
         failures.extend(against_baseline(
             &path,
             &results.summary(),

@@ -12,7 +12,7 @@
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
-use super::config::{config_dir, stem};
+use super::config::{config_dir, resolve, stem};
 use super::plan::Plan;
 use crate::error::{Error, Result};
 use crate::mesh::{self, LoadOptions, Mesh};
@@ -36,12 +36,14 @@ pub struct GoldenOutcome {
 pub fn golden_dir(plan: &Plan) -> PathBuf {
     let base = config_dir(&plan.config_path);
     match &plan.config.golden.dir {
-        Some(d) => base.join(d),
-        None => base
-            .join("..")
-            .join("reference")
-            .join("golden")
-            .join(stem(&plan.config_path)),
+        Some(d) => resolve(&base, d),
+        None => resolve(
+            &base,
+            &Path::new("..")
+                .join("reference")
+                .join("golden")
+                .join(stem(&plan.config_path)),
+        ),
     }
 }
 

@@ -11,7 +11,7 @@
 
 use std::path::{Path, PathBuf};
 
-use super::config::{Config, Thresholds, config_dir};
+use super::config::{Config, Thresholds, config_dir, resolve};
 use crate::error::{Error, Result};
 use crate::simplify::meshopt::Target;
 
@@ -136,7 +136,7 @@ impl Plan {
             for (i, l) in a.lods.iter().enumerate() {
                 lods.push(LodPlan {
                     name: names[i].0.clone(),
-                    source: LodSource::File(base.join(&l.mesh)),
+                    source: LodSource::File(resolve(&base, &l.mesh)),
                     switch_m: l.switch_m.map(|s| s.0),
                     limits: layer(
                         &l.thresholds,
@@ -165,7 +165,7 @@ impl Plan {
             }
             assets.push(AssetPlan {
                 name: a.name.0.clone(),
-                mesh: base.join(&a.mesh),
+                mesh: resolve(&base, &a.mesh),
                 meters_per_unit: a.meters_per_unit.0,
                 lods,
             });

@@ -6,8 +6,9 @@
 //! Decisions:
 //! - Views are the outer loop: one original render and its prepared metric forms are alive at a
 //!   time, so memory does not grow with the number of views (1024² nightly runs stay small).
-//!   Parallelism lives inside the renderer and the metrics, so results never depend on which
-//!   thread finished first.
+//!   Within a view the LODs run in parallel (besides the parallelism inside the renderer and the
+//!   metrics); their results are recorded in LOD order, so nothing depends on which finished
+//!   first.
 //! - Every LOD is rendered with the original's cameras (framed on the original's bounding sphere),
 //!   as an engine would draw it in the original's place.
 //! - Contact sheets show original | LOD | FLIP heat map (VDP where FLIP is off; SSIM last), the
@@ -15,6 +16,8 @@
 
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
+
+use rayon::prelude::*;
 
 use super::config::{HeatmapChoice, MetricFamily};
 use super::distance::{self, DistanceJob};
@@ -108,36 +111,44 @@ pub fn run(plan: Plan, options: &RunOptions) -> Result<RunOutput> {
             let frame = raster::render(&reference, camera, &settings)?;
             let ref_thumb = thumbnail(&frame.to_srgb8());
             let prepared = scorer.prepare(LinearImage::from(&frame));
-            for (k, lod) in lods.iter().enumerate() {
-                let test_frame = raster::render(&lod.scene, camera, &settings)?;
-                let scored = scorer.score(&prepared, &LinearImage::from(&test_frame))?;
-                for (metric, value) in &scored.values {
+            // The LODs of one view are independent: render and score them in parallel, then
+            // record them in LOD order (outputs never depend on which finished first).
+            let per_lod = lods
+                .par_iter()
+                .map(|lod| -> Result<_> {
+                    let test_frame = raster::render(&lod.scene, camera, &settings)?;
+                    let scored = scorer.score(&prepared, &LinearImage::from(&test_frame))?;
+                    if cfg.images.heatmaps == HeatmapChoice::All {
+                        for (metric, map) in &scored.maps {
+                            write_heat_map(&out_dir, &asset.name, &lod.name, v, metric, map)?;
+                        }
+                    }
+                    let thumbs = scored.maps.first().map(|(_, map)| {
+                        let heat = colormap::heat_map(&map.values, map.width, map.height, 0);
+                        [
+                            ref_thumb.clone(),
+                            thumbnail(&test_frame.to_srgb8()),
+                            thumbnail(&heat),
+                        ]
+                    });
+                    bar.inc(1);
+                    Ok((scored.values, thumbs))
+                })
+                .collect::<Result<Vec<_>>>()?;
+            for (k, (lod, (values, thumbs))) in lods.iter().zip(per_lod).enumerate() {
+                for (metric, value) in values {
                     results.rows.push(MetricRow {
                         asset: asset.name.clone(),
                         lod: lod.name.clone(),
                         triangles: lod.info.triangles,
                         view: v,
                         metric: metric.to_string(),
-                        value: *value,
+                        value,
                     });
                 }
-                if cfg.images.heatmaps == HeatmapChoice::All {
-                    for (metric, map) in &scored.maps {
-                        write_heat_map(&out_dir, &asset.name, &lod.name, v, metric, map)?;
-                    }
+                if let Some(t) = thumbs {
+                    sheets[k].push((v, t));
                 }
-                if let Some((_, map)) = scored.maps.first() {
-                    let heat = colormap::heat_map(&map.values, map.width, map.height, 0);
-                    sheets[k].push((
-                        v,
-                        [
-                            ref_thumb.clone(),
-                            thumbnail(&test_frame.to_srgb8()),
-                            thumbnail(&heat),
-                        ],
-                    ));
-                }
-                bar.inc(1);
             }
         }
         for (k, lod) in lods.iter().enumerate() {

@@ -119,6 +119,22 @@ fn ci_runs_the_readme_test_command() {
 }
 
 #[test]
+fn readme_main_job_is_the_demo_config_and_it_plans_what_the_readme_says() {
+    // The quick start's first command runs configs/demo.toml; the config must load (models
+    // shipped, keys valid) and plan the two models × five LODs the README describes.
+    let readme = std::fs::read_to_string(crate::common::root().join("README.md")).unwrap();
+    assert!(readme.contains("cargo run --release -- eval configs/demo.toml"));
+    let plan = lodeval::eval::Plan::load(&crate::common::root().join("configs/demo.toml")).unwrap();
+    let cases = plan.case_ids();
+    assert_eq!(cases.len(), 10, "{cases:?}");
+    for a in &plan.assets {
+        assert!(a.mesh.exists(), "{}", a.mesh.display());
+    }
+    assert_eq!(plan.config.render.rig.0.directions().len(), 20);
+    assert_eq!(plan.config.render.size.0, 512);
+}
+
+#[test]
 fn diff_reports_every_metric_as_json_and_writes_maps() {
     let dir = tempfile::tempdir().unwrap();
     let o = |f: &str| crate::common::root().join("reference/oracles/flip").join(f);

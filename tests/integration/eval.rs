@@ -463,3 +463,93 @@ fn scores_and_distances_grow_along_the_lod_chain_of_every_shipped_model() {
     assert_eq!(all.len(), 15);
     assert!(all.iter().all(|(_, flip, d)| *flip > 0.0 && *d > 0.0));
 }
+
+/// The Chromium binary, if installed.
+fn chromium() -> Option<PathBuf> {
+    ["chromium", "chromium-browser", "google-chrome"]
+        .iter()
+        .find_map(|name| {
+            let ok = Command::new(name)
+                .arg("--version")
+                .output()
+                .ok()?
+                .status
+                .success();
+            ok.then(|| PathBuf::from(name))
+        })
+}
+
+#[test]
+fn report_renders_in_headless_chromium_with_its_plot_and_contact_sheets() {
+    let Some(browser) = chromium() else {
+        // CI installs Chromium (.ci/run); there a missing browser is a failure, not a skip.
+        assert!(
+            std::env::var_os("CI").is_none(),
+            "Chromium is required under CI for the report screenshot test"
+        );
+        eprintln!("SKIPPED: no chromium on this machine (apt-get install chromium)");
+        return;
+    };
+    let dir = tempfile::tempdir().unwrap();
+    let assets = asset(
+        "spot",
+        &model("spot/spot_mtl.obj"),
+        "generate = { method = \"meshopt\", ratios = [0.5, 0.1] }",
+    );
+    let cfg = config(dir.path(), "[thresholds]\nflip_mean = 0.03\n", &assets);
+    let r = lodeval(["eval", cfg.to_str().unwrap()]);
+    assert_eq!(r.code, 1, "the 10 % LOD fails the gate: {}", r.stderr);
+    let report = dir.path().join("out/report.html");
+    let shot = dir.path().join("shot.png");
+    let out = Command::new(&browser)
+        .args([
+            "--headless",
+            "--no-sandbox",
+            "--disable-gpu",
+            "--hide-scrollbars",
+            "--window-size=1200,1600",
+            &format!("--screenshot={}", shot.display()),
+        ])
+        .arg(format!("file://{}", report.display()))
+        .output()
+        .unwrap();
+    assert!(shot.exists(), "{}", String::from_utf8_lossy(&out.stderr));
+    let img = image::open(&shot).unwrap().to_rgb8();
+    assert_eq!(img.dimensions(), (1200, 1600));
+    let count = |f: &dyn Fn(&image::Rgb<u8>) -> bool| img.pixels().filter(|p| f(p)).count();
+    // The plot line (#b5367a), the failing row's tint (#fde2e2) and the renders' mid-grey
+    // background inside the contact sheets must all be on screen.
+    let near = |p: &image::Rgb<u8>, c: [u8; 3]| {
+        p.0.iter()
+            .zip(c)
+            .all(|(a, b)| (*a as i32 - b as i32).abs() <= 6)
+    };
+    let plot = count(&|p| near(p, [0xb5, 0x36, 0x7a]));
+    let fail_row = count(&|p| near(p, [0xfd, 0xe2, 0xe2]));
+    let grey = count(&|p| near(p, [128, 128, 128]));
+    eprintln!("plot {plot} px, failing row {fail_row} px, render background {grey} px");
+    assert!(plot > 200, "plot not drawn ({plot} px)");
+    assert!(fail_row > 2000, "failing row not shown ({fail_row} px)");
+    assert!(grey > 20_000, "contact sheets not loaded ({grey} px)");
+}
+
+#[test]
+fn the_shipped_ci_config_passes_its_gate_and_matches_its_goldens() {
+    let dir = tempfile::tempdir().unwrap();
+    let cfg = crate::common::root().join("configs/ci.toml");
+    let r = lodeval([
+        "eval",
+        cfg.to_str().unwrap(),
+        "--out",
+        dir.path().to_str().unwrap(),
+    ]);
+    assert_eq!(r.code, 0, "{}{}", r.stdout, r.stderr);
+    let r = lodeval([
+        "golden",
+        cfg.to_str().unwrap(),
+        "--out",
+        dir.path().to_str().unwrap(),
+    ]);
+    assert_eq!(r.code, 0, "{}{}", r.stdout, r.stderr);
+    assert!(r.stdout.contains("24 image(s) match"), "{}", r.stdout);
+}
