@@ -45,6 +45,8 @@ enum Command {
     Simplify(NotYet),
     /// Image-driven optimisation of a simplified mesh (not built yet).
     Optimize(NotYet),
+    /// Geometric error between two meshes: Hausdorff, mean and RMS surface distance (Metro-style).
+    Geometry(GeometryArgs),
     /// Run a benchmark (`raster`) and print its table.
     Bench(BenchArgs),
     /// Merge the outputs of sharded runs into what one machine would have written.
@@ -278,6 +280,20 @@ struct GoldenArgs {
 }
 
 #[derive(Args, Debug)]
+struct GeometryArgs {
+    /// The original mesh (distances are also given relative to its bounding-box diagonal).
+    a: PathBuf,
+    /// The mesh compared with it.
+    b: PathBuf,
+    /// Face samples per mesh (every vertex is sampled too).
+    #[arg(long, default_value_t = 1_000_000)]
+    samples: usize,
+    /// Print JSON.
+    #[arg(long)]
+    json: bool,
+}
+
+#[derive(Args, Debug)]
 struct MergeArgs {
     /// Output folders of the shard runs.
     #[arg(required = true)]
@@ -499,6 +515,30 @@ fn run(cli: Cli) -> Result<(), Error> {
             };
             let outcome = lodeval::eval::eval(&a.config, &options)?;
             gate_result(&outcome)
+        }
+        Command::Geometry(a) => {
+            let opts = LoadOptions::DEFAULT;
+            let (ma, mb) = (
+                lodeval::mesh::load(&a.a, &opts)?,
+                lodeval::mesh::load(&a.b, &opts)?,
+            );
+            let d = lodeval::mesh::surface_distance::compare(&ma, &mb, a.samples);
+            if a.json {
+                return emit_json(&d);
+            }
+            emit(&format!(
+                "hausdorff {:.6e} ({:.4} % of the diagonal)\nmean      {:.6e} ({:.4} %)\nrms       {:.6e} ({:.4} %)\nsamples   {} on A, {} on B; one-sided max A→B {:.6e}, B→A {:.6e}\n",
+                d.hausdorff,
+                d.hausdorff_relative * 100.0,
+                d.mean,
+                d.mean_relative * 100.0,
+                d.rms,
+                d.rms_relative * 100.0,
+                d.samples[0],
+                d.samples[1],
+                d.one_sided_max[0],
+                d.one_sided_max[1]
+            ))
         }
         Command::Merge(a) => {
             let outcome = lodeval::eval::merge(&a.shards, &a.out)?;

@@ -29,6 +29,7 @@ mod off;
 mod ply;
 pub mod shapes;
 mod summary;
+pub mod surface_distance;
 mod texture;
 mod validate;
 mod weld;
