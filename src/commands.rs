@@ -548,3 +548,134 @@ pub fn bench_metrics(reference: &Path, test: &Path, runs: usize) -> Result<Vec<M
         })
         .collect()
 }
+
+/// A `lodeval simplify` request.
+#[derive(Debug, Clone)]
+pub struct SimplifyJob {
+    /// Input mesh.
+    pub mesh: PathBuf,
+    /// Output `.obj` (with `--chain`: the stem; files become `STEM-rXX.obj`).
+    pub out: PathBuf,
+    /// Method.
+    pub method: crate::simplify::Method,
+    /// Goals (one, or the chain).
+    pub goals: Vec<crate::simplify::Goal>,
+    /// Write one file per goal with a suffix (a chain) rather than `out` itself.
+    pub chain: bool,
+}
+
+/// One written LOD.
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct SimplifyRow {
+    /// The file written.
+    pub file: PathBuf,
+    /// Triangles.
+    pub triangles: usize,
+    /// Over the input's triangles.
+    pub ratio: f64,
+    /// The simplifier's own error estimate, model units.
+    pub simplifier_error: Option<f64>,
+    /// Seconds for the whole chain (wall clock; reporting only).
+    pub seconds: f64,
+}
+
+/// Simplify a mesh and write the LOD(s) as OBJ.
+pub fn simplify(job: &SimplifyJob) -> Result<Vec<SimplifyRow>> {
+    if job.out.extension().and_then(|e| e.to_str()) != Some("obj") {
+        return Err(Error::Usage(format!(
+            "-o {}: lodeval writes LODs as .obj (with .mtl and textures beside it)",
+            job.out.display()
+        )));
+    }
+    let mesh = mesh::load(&job.mesh, &LoadOptions::default())?;
+    let start = std::time::Instant::now();
+    let lods = crate::simplify::chain(&mesh, job.method, &job.goals)?;
+    let seconds = start.elapsed().as_secs_f64();
+    let stem = job
+        .out
+        .file_stem()
+        .map_or_else(|| "lod".into(), |s| s.to_string_lossy().into_owned());
+    let mut rows = Vec::new();
+    for (lod, goal) in lods.iter().zip(&job.goals) {
+        let file = if job.chain {
+            let suffix = match goal {
+                crate::simplify::Goal::Ratio(r) => {
+                    format!("r{}", crate::eval::config::percent_label(*r))
+                }
+                crate::simplify::Goal::Triangles(t) => format!("t{t}"),
+                crate::simplify::Goal::Error(e) => format!("e{e}"),
+            };
+            job.out.with_file_name(format!("{stem}-{suffix}.obj"))
+        } else {
+            job.out.clone()
+        };
+        crate::mesh::write_obj::write(&lod.mesh, &file)?;
+        rows.push(SimplifyRow {
+            file,
+            triangles: lod.mesh.triangle_count(),
+            ratio: lod.mesh.triangle_count() as f64 / mesh.triangle_count() as f64,
+            simplifier_error: lod.error,
+            seconds,
+        });
+    }
+    Ok(rows)
+}
+
+/// One row of `lodeval bench simplify`.
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct SimplifyBenchRow {
+    /// Mesh name.
+    pub mesh: String,
+    /// Input triangles.
+    pub input_triangles: usize,
+    /// Method.
+    pub method: String,
+    /// Target ratio.
+    pub ratio: f64,
+    /// Output triangles.
+    pub triangles: usize,
+    /// Seconds for this one simplification from the original (single target, one thread for
+    /// meshopt; ours is single-threaded too).
+    pub seconds: f64,
+    /// Millions of input triangles per second.
+    pub mtri_per_s: f64,
+    /// Measured symmetric Hausdorff distance over the bounding-box diagonal.
+    pub hausdorff_relative: f64,
+    /// Measured mean surface distance over the diagonal.
+    pub mean_relative: f64,
+}
+
+/// Simplify each mesh with QEM and meshopt to each ratio (each from the original), time it and
+/// measure the result with the Metro-style distance. Reporting only.
+pub fn bench_simplify(
+    meshes: &[(String, Mesh)],
+    ratios: &[f64],
+    samples: usize,
+) -> Result<Vec<SimplifyBenchRow>> {
+    use crate::simplify::{Goal, Method};
+    let mut rows = Vec::new();
+    for (name, mesh) in meshes {
+        for &ratio in ratios {
+            for method in [Method::Meshopt, Method::Qem] {
+                let start = std::time::Instant::now();
+                let lod = crate::simplify::chain(mesh, method, &[Goal::Ratio(ratio)])?
+                    .pop()
+                    .ok_or_else(|| Error::Internal("no LOD".into()))?;
+                let seconds = start.elapsed().as_secs_f64();
+                let d = crate::mesh::surface_distance::compare(mesh, &lod.mesh, samples);
+                rows.push(SimplifyBenchRow {
+                    mesh: name.clone(),
+                    input_triangles: mesh.triangle_count(),
+                    method: method.name().into(),
+                    ratio,
+                    triangles: lod.mesh.triangle_count(),
+                    seconds,
+                    mtri_per_s: mesh.triangle_count() as f64 / seconds / 1e6,
+                    hausdorff_relative: d.hausdorff_relative,
+                    mean_relative: d.mean_relative,
+                });
+            }
+        }
+    }
+    Ok(rows)
+}

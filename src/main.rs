@@ -41,8 +41,8 @@ enum Command {
     Eval(EvalArgs),
     /// Compare renders with golden images, or bless new ones.
     Golden(GoldenArgs),
-    /// Simplify a mesh (not built yet).
-    Simplify(NotYet),
+    /// Simplify a mesh (QEM edge collapse, vertex clustering, or meshoptimizer) and write OBJ.
+    Simplify(SimplifyArgs),
     /// Image-driven optimisation of a simplified mesh (not built yet).
     Optimize(NotYet),
     /// Geometric error between two meshes: Hausdorff, mean and RMS surface distance (Metro-style).
@@ -139,10 +139,16 @@ struct DiffArgs {
 
 #[derive(Args, Debug)]
 struct BenchArgs {
-    /// What to measure: `raster`, or `metrics REF TEST`.
+    /// What to measure: `raster`, `metrics REF TEST`, or `simplify MESH...`.
     what: String,
-    /// For `metrics`: the reference and test images.
+    /// For `metrics`: the reference and test images; for `simplify`: the meshes.
     images: Vec<PathBuf>,
+    /// For `simplify`: target ratios, comma separated.
+    #[arg(long, value_delimiter = ',', default_value = "0.5,0.1,0.01")]
+    ratios: Vec<f64>,
+    /// For `simplify`: also a procedural bumpy sphere of 20·4^N triangles (0: none).
+    #[arg(long, default_value_t = 0)]
+    bumpy: u32,
     /// For `metrics`: timed runs per metric.
     #[arg(long, default_value_t = 5)]
     runs: usize,
@@ -277,6 +283,33 @@ struct GoldenArgs {
     /// Where actual and diff images of mismatches go (default: the config's output folder).
     #[arg(long, value_name = "DIR")]
     out: Option<PathBuf>,
+}
+
+#[derive(Args, Debug)]
+struct SimplifyArgs {
+    /// The mesh to simplify.
+    mesh: PathBuf,
+    /// Output .obj (with --chain: files STEM-rXX.obj beside it).
+    #[arg(short, long)]
+    out: PathBuf,
+    /// qem (our edge collapse, Garland–Heckbert quadrics), cluster (Rossignac–Borrel) or meshopt.
+    #[arg(long, default_value = "qem")]
+    method: String,
+    /// Target ratio of the input's triangles.
+    #[arg(long, conflicts_with_all = ["triangles", "error", "chain"])]
+    ratio: Option<f64>,
+    /// Target triangle count.
+    #[arg(long, conflicts_with_all = ["error", "chain"])]
+    triangles: Option<usize>,
+    /// Target error relative to the bounding-box diagonal (qem, meshopt).
+    #[arg(long, conflicts_with = "chain")]
+    error: Option<f64>,
+    /// A chain of ratios, e.g. 0.5,0.25,0.1.
+    #[arg(long, value_delimiter = ',')]
+    chain: Vec<f64>,
+    /// Print JSON.
+    #[arg(long)]
+    json: bool,
 }
 
 #[derive(Args, Debug)]
@@ -464,6 +497,43 @@ fn run(cli: Cli) -> Result<(), Error> {
                 let rows = lodeval::commands::bench_metrics(reference, test, a.runs)?;
                 return emit_json(&rows);
             }
+            if a.what == "simplify" {
+                let mut meshes = Vec::new();
+                for p in &a.images {
+                    let name = p
+                        .file_stem()
+                        .map_or_else(String::new, |s| s.to_string_lossy().into_owned());
+                    meshes.push((name, lodeval::mesh::load(p, &LoadOptions::DEFAULT)?));
+                }
+                if a.bumpy > 0 {
+                    meshes.push((
+                        format!("bumpy-sphere-s{}", a.bumpy),
+                        lodeval::mesh::shapes::bumpy_sphere(a.bumpy),
+                    ));
+                }
+                let rows = lodeval::commands::bench_simplify(&meshes, &a.ratios, 1_000_000)?;
+                if a.json {
+                    return emit_json(&rows);
+                }
+                let mut t = String::from(
+                    "| mesh | input triangles | method | ratio | triangles | seconds | M input tri/s | Hausdorff / diagonal | mean / diagonal |\n|---|---|---|---|---|---|---|---|---|\n",
+                );
+                for r in &rows {
+                    t.push_str(&format!(
+                        "| {} | {} | {} | {} | {} | {:.3} | {:.2} | {:.3e} | {:.3e} |\n",
+                        r.mesh,
+                        r.input_triangles,
+                        r.method,
+                        r.ratio,
+                        r.triangles,
+                        r.seconds,
+                        r.mtri_per_s,
+                        r.hausdorff_relative,
+                        r.mean_relative
+                    ));
+                }
+                return emit(&t);
+            }
             if a.what != "raster" {
                 return Err(Error::Usage(format!(
                     "lodeval bench {}: use `raster` or `metrics REF TEST`",
@@ -515,6 +585,65 @@ fn run(cli: Cli) -> Result<(), Error> {
             };
             let outcome = lodeval::eval::eval(&a.config, &options)?;
             gate_result(&outcome)
+        }
+        Command::Simplify(a) => {
+            use lodeval::simplify::{Goal, Method};
+            let method = match a.method.as_str() {
+                "qem" => Method::Qem,
+                "cluster" => Method::Cluster,
+                "meshopt" => Method::Meshopt,
+                m => {
+                    return Err(Error::Usage(format!(
+                        "--method {m}: use qem, cluster or meshopt"
+                    )));
+                }
+            };
+            let unit = |r: f64, what: &str| {
+                if r > 0.0 && r <= 1.0 {
+                    Ok(r)
+                } else {
+                    Err(Error::Usage(format!("{what} {r}: use a value in (0, 1]")))
+                }
+            };
+            let goals: Vec<Goal> = if !a.chain.is_empty() {
+                a.chain
+                    .iter()
+                    .map(|&r| unit(r, "--chain").map(Goal::Ratio))
+                    .collect::<Result<_, _>>()?
+            } else if let Some(r) = a.ratio {
+                vec![Goal::Ratio(unit(r, "--ratio")?)]
+            } else if let Some(t) = a.triangles {
+                vec![Goal::Triangles(t.max(1))]
+            } else if let Some(e) = a.error {
+                vec![Goal::Error(unit(e, "--error")?)]
+            } else {
+                return Err(Error::Usage(
+                    "give --ratio R, --triangles N, --error E or --chain R1,R2,...".into(),
+                ));
+            };
+            let job = lodeval::commands::SimplifyJob {
+                mesh: a.mesh,
+                out: a.out,
+                method,
+                chain: !a.chain.is_empty(),
+                goals,
+            };
+            let rows = lodeval::commands::simplify(&job)?;
+            if a.json {
+                return emit_json(&rows);
+            }
+            let mut text = String::new();
+            for r in &rows {
+                text.push_str(&format!(
+                    "{}  {} triangles ({:.4} of the input), simplifier error {}\n",
+                    r.file.display(),
+                    r.triangles,
+                    r.ratio,
+                    r.simplifier_error
+                        .map_or_else(|| "-".to_string(), |e| format!("{e:.3e}"))
+                ));
+            }
+            emit(&text)
         }
         Command::Geometry(a) => {
             let opts = LoadOptions::DEFAULT;

@@ -34,6 +34,10 @@ pub struct Config {
     /// Metric families to compute. Default value: `["flip", "ssim", "psnr", "vdp"]`.
     #[serde(default = "default_metrics")]
     pub metrics: Vec<MetricFamily>,
+    /// Face samples per mesh for the geometric error columns of `lods.csv` (Hausdorff, mean and
+    /// RMS surface distance); 0 turns them off. Default value: 200000.
+    #[serde(default = "default_geometry_samples")]
+    pub geometry_samples: usize,
     /// FLIP per-pixel level above which a pixel counts as "different" for `flip_share`. Default 0.1.
     #[serde(default = "default_flip_pixel")]
     pub flip_pixel_threshold: UnitInterval,
@@ -64,6 +68,10 @@ fn default_metrics() -> Vec<MetricFamily> {
         MetricFamily::Psnr,
         MetricFamily::Vdp,
     ]
+}
+
+fn default_geometry_samples() -> usize {
+    200_000
 }
 
 fn default_flip_pixel() -> UnitInterval {
@@ -398,25 +406,19 @@ pub struct LodConfig {
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct GenerateConfig {
-    /// `meshopt` (meshoptimizer's `simplify`, the industrial baseline).
-    pub method: Method,
+    /// `meshopt` (meshoptimizer's `simplify`, the industrial baseline), `qem` (our edge collapse
+    /// with Garland–Heckbert quadrics) or `cluster` (Rossignac–Borrel vertex clustering).
+    pub method: crate::simplify::Method,
     /// Target triangle ratios of the original, each LOD simplified from the previous one.
     #[serde(default)]
     pub ratios: Vec<UnitInterval>,
-    /// Target errors (meshoptimizer's relative error), as further LODs of the chain.
+    /// Target errors relative to the bounding-box diagonal (each method's own error measure), as
+    /// further LODs of the chain.
     #[serde(default)]
     pub errors: Vec<UnitInterval>,
     /// Engine switch distances for the generated LODs, metres, in chain order.
     #[serde(default)]
     pub switch_m: Vec<Positive>,
-}
-
-/// Simplifiers a generator may name.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
-#[serde(rename_all = "lowercase")]
-pub enum Method {
-    /// meshoptimizer (`meshopt` crate).
-    Meshopt,
 }
 
 /// Metric families; each writes one or more `metric` values into `metrics.csv`.
@@ -657,10 +659,16 @@ impl Config {
         if let Some(g) = &asset.generate {
             let base = out.len();
             for (k, r) in g.ratios.iter().enumerate() {
-                out.push((format!("meshopt-r{}", percent_label(r.0)), base + k));
+                out.push((
+                    format!("{}-r{}", g.method.name(), percent_label(r.0)),
+                    base + k,
+                ));
             }
             for (k, e) in g.errors.iter().enumerate() {
-                out.push((format!("meshopt-e{}", e.0), base + g.ratios.len() + k));
+                out.push((
+                    format!("{}-e{}", g.method.name(), e.0),
+                    base + g.ratios.len() + k,
+                ));
             }
         }
         out

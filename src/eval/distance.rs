@@ -104,8 +104,8 @@ pub struct DistanceJob<'a> {
     pub directions: Vec<Vec3>,
     /// Metres per model unit.
     pub meters_per_unit: f64,
-    /// meshoptimizer's error in model units, if known.
-    pub meshopt_error: Option<f64>,
+    /// The simplifier's error estimate in model units, if known.
+    pub simplifier_error: Option<f64>,
     /// Asset and LOD names and the LOD's triangle count, for the rows.
     pub names: (&'a str, &'a str, usize),
 }
@@ -229,7 +229,7 @@ pub fn search(
             unreal_screen_size: round7(unreal),
             screen_coverage: round7(coverage),
             pixel_error: job
-                .meshopt_error
+                .simplifier_error
                 .map(|e| round7(e * job.meters_per_unit * display.k / d_m)),
             diameter_px: round7(display.diameter_px(r_m, d_m)),
             resolved,

@@ -13,15 +13,17 @@ use std::path::{Path, PathBuf};
 
 use super::config::{Config, Thresholds, config_dir, resolve};
 use crate::error::{Error, Result};
-use crate::simplify::meshopt::Target;
+use crate::simplify::{Goal, Method};
 
 /// Where a LOD's mesh comes from.
 #[derive(Debug, Clone, PartialEq)]
 pub enum LodSource {
     /// A file.
     File(PathBuf),
-    /// Step `step` (0-based) of the asset's meshoptimizer chain.
-    Meshopt {
+    /// Step `step` (0-based) of the asset's generated chain.
+    Generated {
+        /// The simplifier.
+        method: Method,
         /// Position in the chain.
         step: usize,
         /// Ratio of the original's triangles or relative error.
@@ -34,18 +36,16 @@ pub enum LodSource {
 pub enum GenTarget {
     /// Fraction of the original's triangle count.
     Ratio(f64),
-    /// meshoptimizer relative error.
+    /// Error relative to the bounding-box diagonal.
     Error(f64),
 }
 
 impl GenTarget {
-    /// The simplifier target for an original of `triangles` triangles.
-    pub fn target(self, triangles: usize) -> Target {
+    /// The simplifier goal.
+    pub fn goal(self) -> Goal {
         match self {
-            GenTarget::Ratio(r) => {
-                Target::Triangles((triangles as f64 * r).round().max(1.0) as usize)
-            }
-            GenTarget::Error(e) => Target::Error(e as f32),
+            GenTarget::Ratio(r) => Goal::Ratio(r),
+            GenTarget::Error(e) => Goal::Error(e),
         }
     }
 }
@@ -157,7 +157,11 @@ impl Plan {
                 for (step, target) in targets.enumerate() {
                     lods.push(LodPlan {
                         name: names[a.lods.len() + step].0.clone(),
-                        source: LodSource::Meshopt { step, target },
+                        source: LodSource::Generated {
+                            method: g.method,
+                            step,
+                            target,
+                        },
                         switch_m: g.switch_m.get(step).map(|s| s.0),
                         limits: asset_limits.clone(),
                     });

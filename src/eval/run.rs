@@ -25,11 +25,11 @@ use super::plan::{AssetPlan, GenTarget, LodSource, Plan, Shard, case_id};
 use super::score::Scorer;
 use super::tables::{LodInfo, MetricRow, Results, higher_is_worse, round7};
 use crate::error::Result;
-use crate::mesh::{self, LoadOptions, Mesh};
+use crate::mesh::{self, LoadOptions, Mesh, surface_distance};
 use crate::metric::{LinearImage, colormap};
 use crate::raster;
 use crate::scene::Scene;
-use crate::simplify::meshopt;
+use crate::simplify::{self, Method};
 
 /// How to run.
 #[derive(Debug, Clone)]
@@ -99,10 +99,20 @@ pub fn run(plan: Plan, options: &RunOptions) -> Result<RunOutput> {
         let reference = scene_for(cfg, original.clone());
         let lods = build_lods(asset, &original, &wanted)?
             .into_iter()
-            .map(|(name, mesh, info)| LodScene {
-                name,
-                scene: scene_for(cfg, Arc::new(mesh)),
-                info,
+            .map(|(name, mesh, mut info)| {
+                if cfg.geometry_samples > 0 {
+                    let d = surface_distance::compare(&original, &mesh, cfg.geometry_samples);
+                    info.hausdorff = Some(round7(d.hausdorff));
+                    info.mean_distance = Some(round7(d.mean));
+                    info.rms_distance = Some(round7(d.rms));
+                    info.hausdorff_relative = Some(round7(d.hausdorff_relative));
+                    info.mean_relative = Some(round7(d.mean_relative));
+                }
+                LodScene {
+                    name,
+                    scene: scene_for(cfg, Arc::new(mesh)),
+                    info,
+                }
             })
             .collect::<Vec<_>>();
         let cameras = crate::commands::rig_cameras(&original, &cfg.render.rig.0, 1.0);
@@ -193,7 +203,7 @@ pub fn run(plan: Plan, options: &RunOptions) -> Result<RunOutput> {
                     lod: &lod.scene,
                     directions,
                     meters_per_unit: asset.meters_per_unit,
-                    meshopt_error: lod.info.meshopt_error,
+                    simplifier_error: lod.info.simplifier_error,
                     names: (&asset.name, &lod.name, lod.info.triangles),
                 };
                 results.distances.extend(distance::search(
@@ -226,56 +236,67 @@ pub fn scene_for(cfg: &super::config::Config, mesh: Arc<Mesh>) -> Scene {
     s
 }
 
-/// Load or generate the wanted LODs of an asset (generated chains are built up to the last
-/// wanted step, since each step starts from the previous one).
+/// Load or generate the wanted LODs of an asset (a generated chain is built up to its last wanted
+/// step, since steps may start from the previous one).
 pub fn build_lods(
     asset: &AssetPlan,
     original: &Mesh,
     wanted: &[bool],
 ) -> Result<Vec<(String, Mesh, LodInfo)>> {
-    let mut out = Vec::new();
-    let last_generated = asset
+    // The generated chain, computed once up to the last wanted step.
+    let generated: Vec<(Method, GenTarget)> = asset
+        .lods
+        .iter()
+        .filter_map(|l| match l.source {
+            LodSource::Generated { method, target, .. } => Some((method, target)),
+            LodSource::File(_) => None,
+        })
+        .collect();
+    let last = asset
         .lods
         .iter()
         .zip(wanted)
-        .filter(|(l, w)| **w && matches!(l.source, LodSource::Meshopt { .. }))
-        .filter_map(|(l, _)| match l.source {
-            LodSource::Meshopt { step, .. } => Some(step),
-            LodSource::File(_) => None,
+        .filter_map(|(l, w)| match l.source {
+            LodSource::Generated { step, .. } if *w => Some(step),
+            _ => None,
         })
         .max();
-    let mut chain: Vec<(Mesh, f64)> = Vec::new();
+    let mut chain = match (last, generated.first()) {
+        (Some(last), Some(&(method, _))) => {
+            let goals: Vec<_> = generated[..=last].iter().map(|g| g.1.goal()).collect();
+            simplify::chain(original, method, &goals)?
+                .into_iter()
+                .map(Some)
+                .collect()
+        }
+        _ => Vec::new(),
+    };
+    let mut out = Vec::new();
     for (lod, &want) in asset.lods.iter().zip(wanted) {
+        if !want {
+            continue;
+        }
         let (mesh, source, error) = match &lod.source {
-            LodSource::File(path) => {
-                if !want {
-                    continue;
-                }
-                (
-                    mesh::load(path, &LoadOptions::default())?,
-                    path.display().to_string(),
-                    None,
-                )
-            }
-            LodSource::Meshopt { step, target } => {
-                if last_generated.is_none_or(|last| *step > last) {
-                    continue;
-                }
-                let (input, accumulated) = match chain.last() {
-                    Some((m, e)) => (m, *e),
-                    None => (original, 0.0),
-                };
-                let s = meshopt::simplify(input, target.target(original.triangle_count()))?;
-                let error = accumulated + s.absolute_error as f64;
-                chain.push((s.mesh.clone(), error));
-                if !want {
-                    continue;
-                }
+            LodSource::File(path) => (
+                mesh::load(path, &LoadOptions::default())?,
+                path.display().to_string(),
+                None,
+            ),
+            LodSource::Generated {
+                method,
+                step,
+                target,
+            } => {
+                let l = chain[*step].take().expect("each step is taken once");
                 let what = match target {
-                    GenTarget::Ratio(r) => format!("meshopt ratio {r} (chain step {})", step + 1),
-                    GenTarget::Error(e) => format!("meshopt error {e} (chain step {})", step + 1),
+                    GenTarget::Ratio(r) => {
+                        format!("{} ratio {r} (chain step {})", method.name(), step + 1)
+                    }
+                    GenTarget::Error(e) => {
+                        format!("{} error {e} (chain step {})", method.name(), step + 1)
+                    }
                 };
-                (s.mesh, what, Some(round7(error)))
+                (l.mesh, what, l.error.map(round7))
             }
         };
         let info = LodInfo {
@@ -284,8 +305,13 @@ pub fn build_lods(
             triangles: mesh.triangle_count(),
             original_triangles: original.triangle_count(),
             source,
-            meshopt_error: error,
+            simplifier_error: error,
             switch_m: lod.switch_m,
+            hausdorff: None,
+            mean_distance: None,
+            rms_distance: None,
+            hausdorff_relative: None,
+            mean_relative: None,
         };
         out.push((lod.name.clone(), mesh, info));
     }

@@ -49,11 +49,21 @@ pub struct LodInfo {
     pub original_triangles: usize,
     /// Where the LOD came from (file path or generator step).
     pub source: String,
-    /// meshoptimizer's error estimate in model units, for generated LODs (accumulated along the
-    /// chain).
-    pub meshopt_error: Option<f64>,
+    /// The simplifier's own error estimate in model units, for generated LODs (meshoptimizer's
+    /// accumulated along its chain; QEM's largest collapse error).
+    pub simplifier_error: Option<f64>,
     /// The engine's switch distance from the config, metres.
     pub switch_m: Option<f64>,
+    /// Symmetric Hausdorff distance to the original, model units (Metro-style sampling).
+    pub hausdorff: Option<f64>,
+    /// Mean surface distance to the original, model units.
+    pub mean_distance: Option<f64>,
+    /// RMS surface distance to the original, model units.
+    pub rms_distance: Option<f64>,
+    /// `hausdorff` over the original's bounding-box diagonal.
+    pub hausdorff_relative: Option<f64>,
+    /// `mean_distance` over the diagonal.
+    pub mean_relative: Option<f64>,
 }
 
 /// One imperceptibility distance.
@@ -77,7 +87,8 @@ pub struct DistanceRow {
     pub unreal_screen_size: f64,
     /// Share of the screen area the bounding sphere covers (glTF `MSFT_lod` screen coverage).
     pub screen_coverage: f64,
-    /// meshoptimizer's error projected to display pixels at that distance, where known.
+    /// The simplifier's error estimate projected to display pixels at that distance (as
+    /// meshoptimizer-based LOD selection does), where known.
     pub pixel_error: Option<f64>,
     /// On-screen bounding-sphere diameter at that distance, display pixels.
     pub diameter_px: f64,
@@ -326,8 +337,13 @@ impl Columns for LodInfo {
         "triangles",
         "original_triangles",
         "source",
-        "meshopt_error",
+        "simplifier_error",
         "switch_m",
+        "hausdorff",
+        "mean_distance",
+        "rms_distance",
+        "hausdorff_relative",
+        "mean_relative",
     ];
 }
 
@@ -445,8 +461,13 @@ mod tests {
             triangles: 1,
             original_triangles: 2,
             source: "s".into(),
-            meshopt_error: None,
+            simplifier_error: None,
             switch_m: None,
+            hausdorff: None,
+            mean_distance: None,
+            rms_distance: None,
+            hausdorff_relative: None,
+            mean_relative: None,
         });
         header(DistanceRow {
             asset: "a".into(),

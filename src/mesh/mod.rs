@@ -21,6 +21,7 @@
 //!   [`MissingAssets::Warn`] the material keeps its base colour and a warning is recorded in
 //!   [`Mesh::warnings`].
 
+pub mod adjacency;
 mod bounds;
 mod gltf;
 mod normals;
@@ -33,6 +34,7 @@ pub mod surface_distance;
 mod texture;
 mod validate;
 mod weld;
+pub mod write_obj;
 
 use std::path::{Path, PathBuf};
 use std::sync::Arc;

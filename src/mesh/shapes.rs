@@ -32,6 +32,43 @@ fn finish(name: &str, positions: Vec<Vec3>, triangles: Vec<[u32; 3]>) -> Mesh {
     Mesh::new(data, &LoadOptions::DEFAULT).expect("procedural meshes are valid by construction")
 }
 
+/// The cube [−1, 1]³ with each face an n×n grid of squares (two triangles each), vertices shared
+/// along the cube's edges, counter-clockwise seen from outside.
+pub fn cube_grid(n: u32) -> Mesh {
+    let n = n.max(1);
+    let mut index: HashMap<[i64; 3], u32> = HashMap::new();
+    let mut positions = Vec::new();
+    let mut triangles = Vec::new();
+    // Each face: outward axis, and two in-plane axes (u, v) with u × v = outward.
+    let faces: [(Vec3, Vec3, Vec3); 6] = [
+        (Vec3::X, Vec3::Y, Vec3::Z),
+        (-Vec3::X, Vec3::Z, Vec3::Y),
+        (Vec3::Y, Vec3::Z, Vec3::X),
+        (-Vec3::Y, Vec3::X, Vec3::Z),
+        (Vec3::Z, Vec3::X, Vec3::Y),
+        (-Vec3::Z, Vec3::Y, Vec3::X),
+    ];
+    for (w, u, v) in faces {
+        let mut id = |i: u32, j: u32| {
+            let p =
+                w + u * (2.0 * i as f32 / n as f32 - 1.0) + v * (2.0 * j as f32 / n as f32 - 1.0);
+            let key = p.to_array().map(|c| (c * 1e6).round() as i64);
+            *index.entry(key).or_insert_with(|| {
+                positions.push(p);
+                positions.len() as u32 - 1
+            })
+        };
+        for j in 0..n {
+            for i in 0..n {
+                let (a, b, c, d) = (id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1));
+                triangles.push([a, b, c]);
+                triangles.push([a, c, d]);
+            }
+        }
+    }
+    finish("cube", positions, triangles)
+}
+
 /// A unit icosphere: the icosahedron with each triangle split into 4, `subdivisions` times
 /// (20·4^s triangles), vertices projected to the sphere, counter-clockwise seen from outside.
 pub fn icosphere(subdivisions: u32) -> Mesh {

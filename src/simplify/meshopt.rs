@@ -7,11 +7,8 @@
 //! - Multi-material meshes are simplified one material at a time, with the vertices that several
 //!   materials share locked, so material borders cannot open cracks. The triangle target is
 //!   shared out in proportion to each material's triangles.
-//! - meshoptimizer detects UV/normal seams itself from coinciding positions, and keeps them. A mesh
-//!   without UVs or colours whose normals are split everywhere (flat shading: every vertex a seam)
-//!   would not simplify at all that way, so such meshes are simplified on their welded positions,
-//!   and the LOD gets its normals the way the original had them: per-face normals if the
-//!   original's were flat (≥ 99 % of triangles), generated smooth normals otherwise.
+//! - meshoptimizer detects UV/normal seams itself from coinciding positions, and keeps them.
+//!   Meshes split only by normals go through [`super::chain`]'s welded path first.
 //! - The reported error is meshoptimizer's own estimate, relative to the mesh extent (its
 //!   `result_error`); an absolute value in model units is that times `simplify_scale`. It is known
 //!   to under-state the true maximum deviation; lodeval's Hausdorff distance is the honest one.
@@ -41,76 +38,12 @@ pub struct Simplified {
 
 /// Simplify `mesh` towards `target`.
 pub fn simplify(mesh: &Mesh, target: Target) -> Result<Simplified> {
-    if mesh.uvs().is_none()
-        && mesh.colors().is_none()
-        && mesh.welded_vertex_count() < mesh.vertex_count()
-    {
-        return simplify_welded(mesh, target);
-    }
     let positions: Vec<[f32; 3]> = mesh.positions().iter().map(|p| p.to_array()).collect();
     let tris = mesh.triangles().to_vec();
     let (out_tris, out_mats, worst_error) = by_material(mesh, &positions, &tris, target);
     let mut data = mesh.to_data();
     data.normals = Some(mesh.normals().to_vec());
     data.triangles = out_tris;
-    data.material_ids = out_mats;
-    let scale = ::meshopt::simplify_scale_decoder(&positions);
-    Ok(Simplified {
-        mesh: Mesh::new(data, &LoadOptions::default())?,
-        relative_error: worst_error,
-        absolute_error: worst_error * scale,
-    })
-}
-
-/// Simplify on welded positions (see the module comment).
-fn simplify_welded(mesh: &Mesh, target: Target) -> Result<Simplified> {
-    let weld = mesh.weld();
-    let mut positions = vec![[0f32; 3]; mesh.welded_vertex_count()];
-    for (v, &w) in weld.iter().enumerate() {
-        positions[w as usize] = mesh.positions()[v].to_array();
-    }
-    let tris: Vec<[u32; 3]> = mesh
-        .triangles()
-        .iter()
-        .map(|t| t.map(|v| weld[v as usize]))
-        .collect();
-    let face_normal = |p: [glam::Vec3; 3]| (p[1] - p[0]).cross(p[2] - p[0]).normalize_or_zero();
-    let flat = mesh
-        .triangles()
-        .iter()
-        .filter(|t| {
-            let n = face_normal(t.map(|v| mesh.positions()[v as usize]));
-            t.iter().all(|&v| mesh.normals()[v as usize].dot(n) > 0.999)
-        })
-        .count()
-        * 100
-        >= mesh.triangle_count() * 99;
-    let (out_tris, out_mats, worst_error) = by_material(mesh, &positions, &tris, target);
-    let mut data = mesh.to_data();
-    let welded: Vec<glam::Vec3> = positions
-        .iter()
-        .map(|p| glam::Vec3::from_array(*p))
-        .collect();
-    if flat {
-        // One vertex per corner, each with its face's normal.
-        data.positions = out_tris
-            .iter()
-            .flat_map(|t| t.map(|v| welded[v as usize]))
-            .collect();
-        data.normals = Some(
-            out_tris
-                .iter()
-                .flat_map(|t| [face_normal(t.map(|v| welded[v as usize])); 3])
-                .collect(),
-        );
-        data.triangles = (0..out_tris.len() as u32)
-            .map(|i| [3 * i, 3 * i + 1, 3 * i + 2])
-            .collect();
-    } else {
-        data.positions = welded;
-        data.normals = None;
-        data.triangles = out_tris;
-    }
     data.material_ids = out_mats;
     let scale = ::meshopt::simplify_scale_decoder(&positions);
     Ok(Simplified {
@@ -204,42 +137,6 @@ mod tests {
             }
         }
         assert!(edges.values().all(|&c| c == 2));
-    }
-
-    #[test]
-    fn flat_shaded_meshes_simplify_and_stay_flat() {
-        // Every vertex split per face (flat normals), as in bunny_odedstein_3k.obj.
-        let smooth = crate::mesh::shapes::icosphere(3);
-        let mut data = smooth.to_data();
-        let p = smooth.positions();
-        data.positions = smooth
-            .triangles()
-            .iter()
-            .flat_map(|t| t.map(|v| p[v as usize]))
-            .collect();
-        data.normals = Some(
-            smooth
-                .triangles()
-                .iter()
-                .flat_map(|t| {
-                    let [a, b, c] = t.map(|v| p[v as usize]);
-                    [(b - a).cross(c - a).normalize(); 3]
-                })
-                .collect(),
-        );
-        data.triangles = (0..smooth.triangle_count() as u32)
-            .map(|i| [3 * i, 3 * i + 1, 3 * i + 2])
-            .collect();
-        data.material_ids = Vec::new();
-        let flat = Mesh::new(data, &LoadOptions::default()).unwrap();
-        let n = flat.triangle_count();
-        let s = simplify(&flat, Target::Triangles(n / 4)).unwrap();
-        assert!(
-            s.mesh.triangle_count() <= n / 4,
-            "{n} -> {}",
-            s.mesh.triangle_count()
-        );
-        assert_eq!(s.mesh.vertex_count(), 3 * s.mesh.triangle_count());
     }
 
     #[test]

@@ -1,5 +1,262 @@
-//! Simplifiers: each algorithm in its own file. Today: the industrial baseline (meshoptimizer,
-//! `meshopt.rs`) that `eval`'s LOD generator calls. The edge-collapse engine (QEM, clustering) and
-//! the paper algorithms (Williams et al., Menzel–Guthe, Lindstrom–Turk, Qu–Meyer) join here.
+//! Simplifiers, one algorithm per file: the industrial baseline (meshoptimizer, `meshopt.rs`), our
+//! edge-collapse engine with Garland–Heckbert quadrics (`qem.rs`, on `mesh::adjacency`), and
+//! Rossignac–Borrel vertex clustering (`cluster.rs`). The paper algorithms (Williams et al.,
+//! Menzel–Guthe, Lindstrom–Turk, Qu–Meyer) join here. This file is the one entry point `eval` and
+//! the CLI use: a method, a chain of targets, LOD meshes out.
 
+pub mod cluster;
 pub mod meshopt;
+pub mod qem;
+
+use crate::error::{Error, Result};
+use crate::mesh::Mesh;
+
+/// A simplification method.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Deserialize, serde::Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Method {
+    /// Our edge collapse with Garland–Heckbert 1997 quadrics.
+    Qem,
+    /// Rossignac–Borrel vertex clustering.
+    Cluster,
+    /// meshoptimizer's `simplify`.
+    Meshopt,
+}
+
+impl Method {
+    /// The name used in LOD names and on the command line.
+    pub fn name(self) -> &'static str {
+        match self {
+            Method::Qem => "qem",
+            Method::Cluster => "cluster",
+            Method::Meshopt => "meshopt",
+        }
+    }
+}
+
+/// What one LOD of a chain aims for.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Goal {
+    /// Fraction of the original's triangles.
+    Ratio(f64),
+    /// Triangle count.
+    Triangles(usize),
+    /// Error relative to the bounding-box diagonal (each method's own error measure).
+    Error(f64),
+}
+
+/// A LOD and the simplifier's own error estimate for it (model units), where it has one.
+#[derive(Debug, Clone)]
+pub struct Lod {
+    /// The mesh.
+    pub mesh: Mesh,
+    /// The simplifier's error estimate in model units.
+    pub error: Option<f64>,
+}
+
+/// For a mesh without UVs or colours whose vertices are split only by normals (flat shading makes
+/// every vertex a seam, and no seam-respecting simplifier could collapse anything): the welded
+/// mesh with smooth normals, and whether the original was flat-shaded (≥ 99 % of triangles have
+/// all three corner normals equal to the face normal).
+fn normal_only_seams(mesh: &Mesh) -> Option<(Mesh, bool)> {
+    if mesh.uvs().is_some()
+        || mesh.colors().is_some()
+        || mesh.welded_vertex_count() == mesh.vertex_count()
+    {
+        return None;
+    }
+    let p = mesh.positions();
+    let face_normal = |t: &[u32; 3]| {
+        let [a, b, c] = t.map(|v| p[v as usize]);
+        (b - a).cross(c - a).normalize_or_zero()
+    };
+    let flat = mesh
+        .triangles()
+        .iter()
+        .filter(|t| {
+            let n = face_normal(t);
+            t.iter().all(|&v| mesh.normals()[v as usize].dot(n) > 0.999)
+        })
+        .count()
+        * 100
+        >= mesh.triangle_count() * 99;
+    let weld = mesh.weld();
+    let mut data = mesh.to_data();
+    let mut positions = vec![glam::Vec3::ZERO; mesh.welded_vertex_count()];
+    for (v, &w) in weld.iter().enumerate() {
+        positions[w as usize] = p[v];
+    }
+    data.positions = positions;
+    data.normals = None;
+    data.triangles = mesh
+        .triangles()
+        .iter()
+        .map(|t| t.map(|v| weld[v as usize]))
+        .collect();
+    Some((
+        Mesh::new(data, &crate::mesh::LoadOptions::default()).ok()?,
+        flat,
+    ))
+}
+
+/// Give a LOD of a flat-shaded original its flat shading back: one vertex per corner with the
+/// face's normal.
+fn flatten(lod: &Mesh) -> Result<Mesh> {
+    let p = lod.positions();
+    let mut data = lod.to_data();
+    data.positions = lod
+        .triangles()
+        .iter()
+        .flat_map(|t| t.map(|v| p[v as usize]))
+        .collect();
+    data.normals = Some(
+        lod.triangles()
+            .iter()
+            .flat_map(|t| {
+                let [a, b, c] = t.map(|v| p[v as usize]);
+                [(b - a).cross(c - a).normalize_or(glam::Vec3::Z); 3]
+            })
+            .collect(),
+    );
+    data.triangles = (0..lod.triangle_count() as u32)
+        .map(|i| [3 * i, 3 * i + 1, 3 * i + 2])
+        .collect();
+    Mesh::new(data, &crate::mesh::LoadOptions::default())
+}
+
+/// Simplify `mesh` to every goal of `chain`, in order. meshoptimizer chains each LOD from the
+/// previous one (as engines build LOD chains); QEM extracts triangle goals as prefixes of one
+/// progressive run from the original (error goals run separately); clustering starts from the
+/// original each time.
+///
+/// Meshes split only by normals are simplified welded, and flat-shaded originals get flat LODs
+/// (see [`normal_only_seams`]).
+pub fn chain(mesh: &Mesh, method: Method, goals: &[Goal]) -> Result<Vec<Lod>> {
+    if let Some((welded, flat)) = normal_only_seams(mesh) {
+        let lods = chain_of(&welded, method, goals)?;
+        return lods
+            .into_iter()
+            .map(|l| {
+                Ok(Lod {
+                    mesh: if flat { flatten(&l.mesh)? } else { l.mesh },
+                    error: l.error,
+                })
+            })
+            .collect();
+    }
+    chain_of(mesh, method, goals)
+}
+
+fn chain_of(mesh: &Mesh, method: Method, goals: &[Goal]) -> Result<Vec<Lod>> {
+    let n = mesh.triangle_count();
+    let tris = |g: Goal| match g {
+        Goal::Ratio(r) => Some((n as f64 * r).round().max(1.0) as usize),
+        Goal::Triangles(t) => Some(t),
+        Goal::Error(_) => None,
+    };
+    let diagonal = mesh.aabb().diagonal() as f64;
+    match method {
+        Method::Meshopt => {
+            let mut out: Vec<Lod> = Vec::new();
+            for &g in goals {
+                let input = out.last().map_or(mesh, |l| &l.mesh);
+                let target = match tris(g) {
+                    Some(t) => meshopt::Target::Triangles(t),
+                    None => match g {
+                        Goal::Error(e) => meshopt::Target::Error(e as f32),
+                        _ => unreachable!(),
+                    },
+                };
+                let s = meshopt::simplify(input, target)?;
+                let acc = out.last().and_then(|l| l.error).unwrap_or(0.0);
+                out.push(Lod {
+                    mesh: s.mesh,
+                    error: Some(acc + s.absolute_error as f64),
+                });
+            }
+            Ok(out)
+        }
+        Method::Qem => {
+            let smallest = goals.iter().filter_map(|&g| tris(g)).min();
+            let progressive = smallest.map(|t| {
+                let adj = crate::mesh::adjacency::Adjacency::new(mesh);
+                let mut cost = qem::QemCost::new(&adj);
+                qem::run(adj, &mut cost, qem::Stop::Triangles(t), diagonal)
+            });
+            goals
+                .iter()
+                .map(|&g| match (tris(g), &progressive, g) {
+                    (Some(t), Some(pm), _) => Ok(Lod {
+                        mesh: pm.extract(t).to_mesh(mesh)?,
+                        error: Some(pm.error_at(t)),
+                    }),
+                    (_, _, Goal::Error(e)) => {
+                        let (m, err) = qem::simplify(mesh, qem::Stop::RelativeError(e))?;
+                        Ok(Lod {
+                            mesh: m,
+                            error: Some(err),
+                        })
+                    }
+                    _ => Err(Error::Internal("qem goal".into())),
+                })
+                .collect()
+        }
+        Method::Cluster => goals
+            .iter()
+            .map(|&g| {
+                let t = tris(g).ok_or_else(|| {
+                    Error::Usage("clustering takes triangle or ratio targets, not an error".into())
+                })?;
+                Ok(Lod {
+                    mesh: cluster::cluster_to(mesh, t)?,
+                    error: None,
+                })
+            })
+            .collect(),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn flat_shaded_meshes_simplify_and_stay_flat() {
+        for method in [Method::Qem, Method::Meshopt, Method::Cluster] {
+            // Every vertex split per face (flat normals), as in bunny_odedstein_3k.obj.
+            let smooth = crate::mesh::shapes::icosphere(3);
+            let mut data = smooth.to_data();
+            let p = smooth.positions();
+            data.positions = smooth
+                .triangles()
+                .iter()
+                .flat_map(|t| t.map(|v| p[v as usize]))
+                .collect();
+            data.normals = Some(
+                smooth
+                    .triangles()
+                    .iter()
+                    .flat_map(|t| {
+                        let [a, b, c] = t.map(|v| p[v as usize]);
+                        [(b - a).cross(c - a).normalize(); 3]
+                    })
+                    .collect(),
+            );
+            data.triangles = (0..smooth.triangle_count() as u32)
+                .map(|i| [3 * i, 3 * i + 1, 3 * i + 2])
+                .collect();
+            data.material_ids = Vec::new();
+            let flat = Mesh::new(data, &crate::mesh::LoadOptions::default()).unwrap();
+            let n = flat.triangle_count();
+            let s = chain(&flat, method, &[Goal::Triangles(n / 4)])
+                .unwrap()
+                .remove(0);
+            assert!(
+                s.mesh.triangle_count() <= n / 4,
+                "{n} -> {}",
+                s.mesh.triangle_count()
+            );
+            assert_eq!(s.mesh.vertex_count(), 3 * s.mesh.triangle_count());
+        }
+    }
+}

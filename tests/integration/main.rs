@@ -11,6 +11,8 @@
 //! - `oracles`: metrics against reference implementations (FLIP: NVIDIA's; SSIM/PSNR: scikit-image).
 //! - `raster`: the CPU rasterizer (determinism over thread counts, watertightness, golden images,
 //!   the `render` CLI).
+//! - `simplify`: `lodeval simplify` and `lodeval geometry`, and the eval generators `qem` and
+//!   `cluster`.
 //! - `vdp`: the visible-difference predictor against established psychophysics.
 
 mod bad_input;
@@ -21,4 +23,5 @@ mod fuzz;
 mod models;
 mod oracles;
 mod raster;
+mod simplify;
 mod vdp;

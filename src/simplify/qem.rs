@@ -1,0 +1,506 @@
+//! Edge-collapse simplification with a pluggable cost, and its first cost: Garland & Heckbert 1997
+//! quadric error metrics ("Surface Simplification Using Quadric Error Metrics").
+//!
+//! - Quadrics: per triangle the plane quadric K_p = p pᵀ weighted by the triangle's area (§5 of
+//!   the paper's area weighting); per border edge a constraint plane through the edge,
+//!   perpendicular to its triangle, weighted by `BORDER_WEIGHT` × edge length² (§4's "preserving
+//!   boundaries"); the same for UV/normal seam edges with `SEAM_WEIGHT`, so seams are kept in
+//!   place as well as never torn (the adjacency's wedge rule does the latter).
+//! - Placement: the optimum v̄ = −A⁻¹b when A is well conditioned (|det| above 1e-9 of the scale),
+//!   else the best of the two endpoints and the midpoint (§4 fallback).
+//! - Queue: a binary heap of (cost, edge) with lazy invalidation by per-vertex version stamps;
+//!   ties are broken by vertex ids, so the collapse sequence is deterministic.
+//! - The record of every accepted collapse (a progressive mesh, Hoppe 1996) lets any LOD of a
+//!   chain be extracted by replaying a prefix; the perceptual simplifiers plug their own cost in
+//!   through [`CollapseCost`].
+//! - The reported error of a collapse is √(Q(v̄)/w), the area-weighted RMS distance of v̄ to the
+//!   planes its quadric holds (model units). Error targets are relative to the bounding-box
+//!   diagonal.
+//!
+//! Not yet: attribute-aware quadrics (Garland–Heckbert 1998 / Hoppe 1999) for normals, UVs and
+//! colours. Today attributes follow the wedge rule (a surviving corner keeps its partner wedge's
+//! values), which keeps seams intact but does not optimise attribute values.
+
+use std::cmp::Reverse;
+use std::collections::BinaryHeap;
+
+use glam::{DVec3, Vec3};
+
+use crate::error::Result;
+use crate::mesh::Mesh;
+use crate::mesh::adjacency::Adjacency;
+
+/// Weight of border constraint planes (× edge length²).
+pub const BORDER_WEIGHT: f64 = 1000.0;
+/// Weight of seam constraint planes (× edge length²).
+pub const SEAM_WEIGHT: f64 = 100.0;
+
+/// A symmetric quadric Q(v) = vᵀAv + 2bᵀv + c, with the total weight of its planes.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct Quadric {
+    a: [f64; 6],
+    b: [f64; 3],
+    c: f64,
+    w: f64,
+}
+
+impl Quadric {
+    /// The quadric of the plane n·x + d = 0 (n unit length), with weight `w`.
+    pub fn plane(n: DVec3, d: f64, w: f64) -> Quadric {
+        Quadric {
+            a: [
+                w * n.x * n.x,
+                w * n.x * n.y,
+                w * n.x * n.z,
+                w * n.y * n.y,
+                w * n.y * n.z,
+                w * n.z * n.z,
+            ],
+            b: [w * d * n.x, w * d * n.y, w * d * n.z],
+            c: w * d * d,
+            w,
+        }
+    }
+
+    /// Sum of two quadrics.
+    pub fn add(&self, o: &Quadric) -> Quadric {
+        let mut r = *self;
+        for i in 0..6 {
+            r.a[i] += o.a[i];
+        }
+        for i in 0..3 {
+            r.b[i] += o.b[i];
+        }
+        r.c += o.c;
+        r.w += o.w;
+        r
+    }
+
+    /// Q(v), the weighted sum of squared plane distances.
+    pub fn eval(&self, v: DVec3) -> f64 {
+        let a = &self.a;
+        let q = a[0] * v.x * v.x
+            + 2.0 * a[1] * v.x * v.y
+            + 2.0 * a[2] * v.x * v.z
+            + a[3] * v.y * v.y
+            + 2.0 * a[4] * v.y * v.z
+            + a[5] * v.z * v.z
+            + 2.0 * (self.b[0] * v.x + self.b[1] * v.y + self.b[2] * v.z)
+            + self.c;
+        q.max(0.0)
+    }
+
+    /// The minimiser −A⁻¹b, if A is well conditioned.
+    pub fn optimum(&self) -> Option<DVec3> {
+        let a = &self.a;
+        let m = glam::DMat3::from_cols(
+            DVec3::new(a[0], a[1], a[2]),
+            DVec3::new(a[1], a[3], a[4]),
+            DVec3::new(a[2], a[4], a[5]),
+        );
+        let det = m.determinant();
+        let scale = (a[0] + a[3] + a[5]).powi(3).max(1e-300);
+        if det.abs() <= 1e-9 * scale {
+            return None;
+        }
+        let x = m.inverse() * -DVec3::new(self.b[0], self.b[1], self.b[2]);
+        x.is_finite().then_some(x)
+    }
+
+    /// √(Q(v)/w): RMS distance to the quadric's planes.
+    pub fn rms(&self, v: DVec3) -> f64 {
+        if self.w > 0.0 {
+            (self.eval(v) / self.w).sqrt()
+        } else {
+            0.0
+        }
+    }
+}
+
+/// A collapse cost: the engine asks it for the cost and placement of collapsing `a` into `b`,
+/// and tells it about accepted collapses.
+pub trait CollapseCost {
+    /// Cost (lower collapses first), the new position, and the error to record (model units).
+    fn evaluate(&self, adj: &Adjacency, a: u32, b: u32) -> (f64, Vec3, f64);
+    /// `a` was collapsed into `b`.
+    fn collapsed(&mut self, adj: &Adjacency, a: u32, b: u32);
+}
+
+/// Garland–Heckbert quadrics.
+#[derive(Debug, Clone)]
+pub struct QemCost {
+    quadrics: Vec<Quadric>,
+}
+
+impl QemCost {
+    /// Quadrics of every vertex of `adj`.
+    pub fn new(adj: &Adjacency) -> QemCost {
+        let mut q = vec![Quadric::default(); adj.positions.len()];
+        let pos = |v: u32| adj.positions[v as usize].as_dvec3();
+        let mut edge_tris: std::collections::BTreeMap<(u32, u32), Vec<u32>> = Default::default();
+        for t in adj.live_triangles() {
+            let [a, b, c] = adj.triangle(t);
+            let n = (pos(b) - pos(a)).cross(pos(c) - pos(a));
+            let area = 0.5 * n.length();
+            if area > 0.0 {
+                let n = n.normalize();
+                let k = Quadric::plane(n, -n.dot(pos(a)), area);
+                for v in [a, b, c] {
+                    q[v as usize] = q[v as usize].add(&k);
+                }
+            }
+            for (x, y) in [(a, b), (b, c), (c, a)] {
+                edge_tris.entry((x.min(y), x.max(y))).or_default().push(t);
+            }
+        }
+        for ((x, y), ts) in edge_tris {
+            let weight = match ts.len() {
+                1 => BORDER_WEIGHT,
+                2 => {
+                    let w = |t: u32, v: u32| {
+                        let k = adj.triangle(t).iter().position(|&u| u == v).unwrap();
+                        adj.corners(t)[k]
+                    };
+                    if w(ts[0], x) != w(ts[1], x) || w(ts[0], y) != w(ts[1], y) {
+                        SEAM_WEIGHT
+                    } else {
+                        continue;
+                    }
+                }
+                _ => continue,
+            };
+            let [a, b, c] = adj.triangle(ts[0]);
+            let face = (pos(b) - pos(a)).cross(pos(c) - pos(a));
+            let e = pos(y) - pos(x);
+            let n = e.cross(face);
+            if n.length_squared() <= 0.0 {
+                continue;
+            }
+            let n = n.normalize();
+            let k = Quadric::plane(n, -n.dot(pos(x)), weight * e.length_squared());
+            q[x as usize] = q[x as usize].add(&k);
+            q[y as usize] = q[y as usize].add(&k);
+        }
+        QemCost { quadrics: q }
+    }
+}
+
+impl CollapseCost for QemCost {
+    fn evaluate(&self, adj: &Adjacency, a: u32, b: u32) -> (f64, Vec3, f64) {
+        let q = self.quadrics[a as usize].add(&self.quadrics[b as usize]);
+        let (pa, pb) = (
+            adj.positions[a as usize].as_dvec3(),
+            adj.positions[b as usize].as_dvec3(),
+        );
+        // b stays put when it may not move; otherwise the optimum or the best fallback.
+        let p = if adj.is_locked(b) {
+            pb
+        } else {
+            match q.optimum() {
+                Some(x) if (x - 0.5 * (pa + pb)).length() <= 2.0 * (pa - pb).length() + 1e-12 => x,
+                _ => [pa, pb, 0.5 * (pa + pb)]
+                    .into_iter()
+                    .min_by(|x, y| q.eval(*x).total_cmp(&q.eval(*y)))
+                    .unwrap(),
+            }
+        };
+        (q.eval(p), p.as_vec3(), q.rms(p))
+    }
+
+    fn collapsed(&mut self, _adj: &Adjacency, a: u32, b: u32) {
+        self.quadrics[b as usize] = self.quadrics[b as usize].add(&self.quadrics[a as usize]);
+    }
+}
+
+/// When to stop.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Stop {
+    /// At or below this many triangles.
+    Triangles(usize),
+    /// Before the first collapse whose error exceeds this fraction of the bounding-box diagonal.
+    RelativeError(f64),
+}
+
+/// One accepted collapse.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Collapse {
+    /// The vertex removed.
+    pub from: u32,
+    /// The vertex kept.
+    pub to: u32,
+    /// Where `to` moved.
+    pub position: Vec3,
+    /// The collapse's error (model units).
+    pub error: f64,
+    /// Triangles after it.
+    pub triangles: usize,
+}
+
+/// The start mesh and the collapse sequence: any prefix is a LOD.
+#[derive(Debug, Clone)]
+pub struct Progressive {
+    /// The full-resolution structure.
+    pub base: Adjacency,
+    /// Accepted collapses in order.
+    pub collapses: Vec<Collapse>,
+    /// The structure after the last collapse (the coarsest LOD, without a replay).
+    pub last: Adjacency,
+}
+
+impl Progressive {
+    /// The structure after the longest prefix of collapses that leaves at least `triangles`
+    /// triangles (all collapses if `triangles` is 0).
+    pub fn extract(&self, triangles: usize) -> Adjacency {
+        if self
+            .collapses
+            .last()
+            .is_none_or(|c| c.triangles >= triangles)
+        {
+            return self.last.clone();
+        }
+        let mut adj = self.base.clone();
+        for c in &self.collapses {
+            if adj.triangle_count() <= triangles {
+                break;
+            }
+            if c.triangles < triangles {
+                break;
+            }
+            adj.collapse(c.from, c.to, c.position)
+                .expect("a recorded collapse replays");
+        }
+        adj
+    }
+
+    /// The largest error among the first collapses down to `triangles`.
+    pub fn error_at(&self, triangles: usize) -> f64 {
+        self.collapses
+            .iter()
+            .take_while(|c| c.triangles >= triangles)
+            .map(|c| c.error)
+            .fold(0.0, f64::max)
+    }
+}
+
+/// Queue entry: (cost bits, a, b, version of a, version of b); the smallest pops first.
+type Entry = Reverse<(u64, u32, u32, u32, u32)>;
+
+/// Run the edge-collapse engine on `adj` with `cost` until `stop`.
+pub fn run(adj: Adjacency, cost: &mut dyn CollapseCost, stop: Stop, diagonal: f64) -> Progressive {
+    let base = adj.clone();
+    let mut adj = adj;
+    let mut version = vec![0u32; adj.positions.len()];
+    let mut heap: BinaryHeap<Entry> = BinaryHeap::new();
+    let push = |heap: &mut BinaryHeap<Entry>,
+                adj: &Adjacency,
+                cost: &dyn CollapseCost,
+                version: &[u32],
+                u: u32,
+                v: u32| {
+        // Prefer moving the vertex that may move: collapse the lower class into the higher.
+        let (a, b) = if adj.is_locked(u) || adj.class(u) > adj.class(v) {
+            (v, u)
+        } else {
+            (u, v)
+        };
+        if adj.is_locked(a) {
+            return;
+        }
+        let (c, _, _) = cost.evaluate(adj, a, b);
+        heap.push(Reverse((
+            c.max(0.0).to_bits(),
+            a,
+            b,
+            version[a as usize],
+            version[b as usize],
+        )));
+    };
+    for (u, v) in adj.edges() {
+        push(&mut heap, &adj, cost, &version, u, v);
+    }
+    let mut collapses = Vec::new();
+    let limit = match stop {
+        Stop::RelativeError(e) => e * diagonal,
+        Stop::Triangles(_) => f64::INFINITY,
+    };
+    while let Some(Reverse((_, a, b, va, vb))) = heap.pop() {
+        if let Stop::Triangles(n) = stop
+            && adj.triangle_count() <= n
+        {
+            break;
+        }
+        if version[a as usize] != va || version[b as usize] != vb {
+            continue;
+        }
+        let (_, p, err) = cost.evaluate(&adj, a, b);
+        if err > limit {
+            break;
+        }
+        let (from, to) = if adj.can_collapse(a, b, p).is_ok() {
+            (a, b)
+        } else if !adj.is_locked(b)
+            && adj.class(b) <= adj.class(a)
+            && adj.can_collapse(b, a, p).is_ok()
+        {
+            (b, a)
+        } else {
+            continue;
+        };
+        adj.collapse(from, to, p).expect("checked");
+        cost.collapsed(&adj, from, to);
+        version[from as usize] += 1;
+        version[to as usize] += 1;
+        collapses.push(Collapse {
+            from,
+            to,
+            position: p,
+            error: err,
+            triangles: adj.triangle_count(),
+        });
+        // Only the edges around `to` changed (its quadric and position); their old entries
+        // carry `to`'s old version and are skipped when popped.
+        for n in adj.neighbours(to) {
+            push(&mut heap, &adj, cost, &version, to, n);
+        }
+    }
+    Progressive {
+        base,
+        collapses,
+        last: adj,
+    }
+}
+
+/// Simplify a mesh with QEM to `stop`; returns the LOD and the largest collapse error (model units).
+pub fn simplify(mesh: &Mesh, stop: Stop) -> Result<(Mesh, f64)> {
+    let adj = Adjacency::new(mesh);
+    let mut cost = QemCost::new(&adj);
+    let pm = run(adj, &mut cost, stop, mesh.aabb().diagonal() as f64);
+    let target = match stop {
+        Stop::Triangles(n) => n,
+        Stop::RelativeError(_) => 0,
+    };
+    let lod = pm.extract(target);
+    Ok((lod.to_mesh(mesh)?, pm.error_at(target)))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mesh::{LoadOptions, MeshData, Source, shapes};
+
+    fn grid_plane(n: u32) -> Mesh {
+        // An n×n grid of unit squares in z = 0, two triangles each.
+        let mut positions = Vec::new();
+        for y in 0..=n {
+            for x in 0..=n {
+                positions.push(Vec3::new(x as f32, y as f32, 0.0));
+            }
+        }
+        let mut triangles = Vec::new();
+        let id = |x: u32, y: u32| y * (n + 1) + x;
+        for y in 0..n {
+            for x in 0..n {
+                triangles.push([id(x, y), id(x + 1, y), id(x + 1, y + 1)]);
+                triangles.push([id(x, y), id(x + 1, y + 1), id(x, y + 1)]);
+            }
+        }
+        let data = MeshData {
+            positions,
+            normals: None,
+            uvs: None,
+            colors: None,
+            triangles,
+            material_ids: Vec::new(),
+            materials: Vec::new(),
+            source: Source {
+                path: "plane".into(),
+                format: crate::mesh::Format::Obj,
+                file_vertices: 0,
+                file_faces: 0,
+                file_unreferenced: 0,
+            },
+            warnings: Vec::new(),
+        };
+        Mesh::new(data, &LoadOptions::default()).unwrap()
+    }
+
+    #[test]
+    fn a_tessellated_plane_collapses_to_two_triangles_with_zero_error() {
+        // Every plane quadric is the same plane and the border constraint planes pass through
+        // the border, so interior and border vertices collapse at zero cost until only the four
+        // corners (where two border planes meet, so moving them costs) remain.
+        let m = grid_plane(8);
+        let (lod, err) = simplify(&m, Stop::Triangles(2)).unwrap();
+        assert_eq!(lod.triangle_count(), 2);
+        assert!(err < 1e-9, "{err}");
+        let mut corners: Vec<[i32; 2]> = lod
+            .positions()
+            .iter()
+            .map(|p| [p.x.round() as i32, p.y.round() as i32])
+            .collect();
+        corners.sort();
+        corners.dedup();
+        assert_eq!(corners, vec![[0, 0], [0, 8], [8, 0], [8, 8]]);
+    }
+
+    #[test]
+    fn a_closed_mesh_stays_closed_and_a_cube_keeps_its_corners() {
+        // A subdivided sphere at 10 %: no border edges appear (link condition), no non-manifold edges.
+        let s = shapes::icosphere(4);
+        let adj = Adjacency::new(&s);
+        let mut cost = QemCost::new(&adj);
+        let pm = run(
+            adj,
+            &mut cost,
+            Stop::Triangles(s.triangle_count() / 10),
+            2.0,
+        );
+        let lod = pm.extract(s.triangle_count() / 10);
+        lod.check().unwrap();
+        assert_eq!(lod.border_edges(), 0);
+        assert_eq!(lod.non_manifold_edges(), 0);
+        assert!(lod.triangle_count() <= s.triangle_count() / 10);
+        // A cube of 2×2 grids per face simplifies to 12 triangles on its 8 corners: corners
+        // are where three face planes meet, the only zero-error positions.
+        let cube = shapes::cube_grid(2);
+        let (lod, err) = simplify(&cube, Stop::Triangles(12)).unwrap();
+        assert_eq!(lod.triangle_count(), 12);
+        assert!(err < 1e-6, "{err}");
+        for p in lod.positions() {
+            assert!(
+                p.abs().cmpge(Vec3::splat(0.999)).all(),
+                "{p} is not a corner"
+            );
+        }
+    }
+
+    #[test]
+    fn seams_are_not_torn() {
+        // Spot has UV seams; after simplification every position still has, for each of its
+        // corners, a UV that came from a wedge of the original seam structure: the number of
+        // border edges (seen on the welded mesh) stays zero.
+        let spot = crate::mesh::load(
+            &std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+                .join("reference/models/spot/spot_mtl.obj"),
+            &LoadOptions::default(),
+        )
+        .unwrap();
+        let (lod, _) = simplify(&spot, Stop::Triangles(spot.triangle_count() / 4)).unwrap();
+        let adj = Adjacency::new(&lod);
+        assert_eq!(adj.border_edges(), 0, "a seam opened into a hole");
+        assert!(lod.triangle_count() <= spot.triangle_count() / 4);
+        assert!(lod.uvs().is_some());
+    }
+
+    #[test]
+    fn quadric_optimum_and_fallback() {
+        let q = Quadric::plane(DVec3::X, -1.0, 1.0)
+            .add(&Quadric::plane(DVec3::Y, -2.0, 1.0))
+            .add(&Quadric::plane(DVec3::Z, -3.0, 1.0));
+        let x = q.optimum().unwrap();
+        assert!((x - DVec3::new(1.0, 2.0, 3.0)).length() < 1e-12);
+        assert!(q.eval(x) < 1e-20);
+        // One plane only: singular.
+        assert!(Quadric::plane(DVec3::Z, 0.0, 1.0).optimum().is_none());
+    }
+}
