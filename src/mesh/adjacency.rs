@@ -184,6 +184,39 @@ impl Adjacency {
         }
     }
 
+    /// Whether the mesh has texture coordinates (wedge UVs are meaningful).
+    pub fn has_uvs(&self) -> bool {
+        self.has_uvs
+    }
+
+    /// Whether the mesh has vertex colours.
+    pub fn has_colors(&self) -> bool {
+        self.has_colors
+    }
+
+    /// The wedges used by `v`'s corners, ascending.
+    pub fn vertex_wedges(&self, v: u32) -> Vec<u32> {
+        let mut w: Vec<u32> = self.vtris[v as usize]
+            .iter()
+            .map(|&t| {
+                let k = self.tris[t as usize].iter().position(|&x| x == v).unwrap();
+                self.corners[t as usize][k]
+            })
+            .collect();
+        w.sort_unstable();
+        w.dedup();
+        w
+    }
+
+    /// For a collapse of `a` into `b`: each wedge of `a` with its partner wedge of `b`.
+    pub fn collapse_wedge_map(&self, a: u32, b: u32) -> Result<Vec<(u32, u32)>, Reject> {
+        let shared = self.edge_triangles(a, b);
+        if shared.is_empty() {
+            return Err(Reject::NoSuchEdge);
+        }
+        self.wedge_map(a, b, &shared)
+    }
+
     /// Forbid moving vertex `v`.
     pub fn lock(&mut self, v: u32) {
         self.locked[v as usize] = true;

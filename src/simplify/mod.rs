@@ -4,6 +4,7 @@
 //! Menzel–Guthe, Lindstrom–Turk, Qu–Meyer) join here. This file is the one entry point `eval` and
 //! the CLI use: a method, a chain of targets, LOD meshes out.
 
+pub mod attributes;
 pub mod cluster;
 pub mod meshopt;
 pub mod qem;
@@ -180,7 +181,7 @@ fn chain_of(mesh: &Mesh, method: Method, goals: &[Goal]) -> Result<Vec<Lod>> {
             let smallest = goals.iter().filter_map(|&g| tris(g)).min();
             let progressive = smallest.map(|t| {
                 let adj = crate::mesh::adjacency::Adjacency::new(mesh);
-                let mut cost = qem::QemCost::new(&adj);
+                let mut cost = qem::QemCost::with_attributes(&adj, diagonal);
                 qem::run(adj, &mut cost, qem::Stop::Triangles(t), diagonal)
             });
             goals

@@ -17,18 +17,20 @@
 //!   planes its quadric holds (model units). Error targets are relative to the bounding-box
 //!   diagonal.
 //!
-//! Not yet: attribute-aware quadrics (Garland–Heckbert 1998 / Hoppe 1999) for normals, UVs and
-//! colours. Today attributes follow the wedge rule (a surviving corner keeps its partner wedge's
-//! values), which keeps seams intact but does not optimise attribute values.
+//! Attributes: with [`QemCost::with_attributes`] (what `simplify` and `eval` use) every wedge also
+//! carries a Garland–Heckbert 1998 generalized quadric over (position, normal, UV, colour)
+//! (`attributes.rs`); it adds to the cost, and the surviving wedges get the attribute values that
+//! minimise it. Without it ([`QemCost::new`]) a surviving corner keeps its partner wedge's values.
 
 use std::cmp::Reverse;
 use std::collections::BinaryHeap;
 
 use glam::{DVec3, Vec3};
 
+use super::attributes::AttributeQuadrics;
 use crate::error::Result;
 use crate::mesh::Mesh;
-use crate::mesh::adjacency::Adjacency;
+use crate::mesh::adjacency::{Adjacency, Wedge};
 
 /// Weight of border constraint planes (× edge length²).
 pub const BORDER_WEIGHT: f64 = 1000.0;
@@ -122,14 +124,24 @@ impl Quadric {
 pub trait CollapseCost {
     /// Cost (lower collapses first), the new position, and the error to record (model units).
     fn evaluate(&self, adj: &Adjacency, a: u32, b: u32) -> (f64, Vec3, f64);
-    /// `a` was collapsed into `b`.
-    fn collapsed(&mut self, adj: &Adjacency, a: u32, b: u32);
+    /// `a` was collapsed into `b` (already applied to `adj`; `map` pairs each wedge of `a` with
+    /// the wedge of `b` it merged into). The cost may set new wedge attributes in `adj`; it
+    /// returns them so the progressive record can replay them.
+    fn collapsed(
+        &mut self,
+        adj: &mut Adjacency,
+        a: u32,
+        b: u32,
+        map: &[(u32, u32)],
+    ) -> Vec<(u32, Wedge)>;
 }
 
-/// Garland–Heckbert quadrics.
+/// Garland–Heckbert quadrics: geometric (1997) for placement, and per-wedge attribute quadrics
+/// (1998, `attributes.rs`) for the attribute values and their share of the cost.
 #[derive(Debug, Clone)]
 pub struct QemCost {
     quadrics: Vec<Quadric>,
+    attributes: Option<AttributeQuadrics>,
 }
 
 impl QemCost {
@@ -181,7 +193,35 @@ impl QemCost {
             q[x as usize] = q[x as usize].add(&k);
             q[y as usize] = q[y as usize].add(&k);
         }
-        QemCost { quadrics: q }
+        QemCost {
+            quadrics: q,
+            attributes: None,
+        }
+    }
+
+    /// The same with attribute quadrics (normals, and UVs and colours where the mesh has them).
+    pub fn with_attributes(adj: &Adjacency, diagonal: f64) -> QemCost {
+        let mut c = QemCost::new(adj);
+        c.attributes = Some(AttributeQuadrics::new(
+            adj,
+            adj.has_uvs(),
+            adj.has_colors(),
+            diagonal,
+        ));
+        c
+    }
+
+    /// The wedge groups after collapsing `a` into `b`: each wedge of `b` with the wedges of `a`
+    /// that merge into it.
+    fn groups(adj: &Adjacency, b: u32, map: &[(u32, u32)]) -> Vec<(u32, Vec<u32>)> {
+        adj.vertex_wedges(b)
+            .into_iter()
+            .map(|wb| {
+                let mut g = vec![wb];
+                g.extend(map.iter().filter(|(_, y)| *y == wb).map(|(x, _)| *x));
+                (wb, g)
+            })
+            .collect()
     }
 }
 
@@ -204,11 +244,39 @@ impl CollapseCost for QemCost {
                     .unwrap(),
             }
         };
-        (q.eval(p), p.as_vec3(), q.rms(p))
+        let mut cost = q.eval(p);
+        if let Some(attrs) = &self.attributes
+            && let Ok(map) = adj.collapse_wedge_map(a, b)
+        {
+            for (wb, group) in Self::groups(adj, b, &map) {
+                cost += attrs.optimal(&group, p, &adj.wedges[wb as usize]).1;
+            }
+        }
+        (cost, p.as_vec3(), q.rms(p))
     }
 
-    fn collapsed(&mut self, _adj: &Adjacency, a: u32, b: u32) {
+    fn collapsed(
+        &mut self,
+        adj: &mut Adjacency,
+        a: u32,
+        b: u32,
+        map: &[(u32, u32)],
+    ) -> Vec<(u32, Wedge)> {
         self.quadrics[b as usize] = self.quadrics[b as usize].add(&self.quadrics[a as usize]);
+        let Some(attrs) = &mut self.attributes else {
+            return Vec::new();
+        };
+        let mut changes = Vec::new();
+        let x = adj.positions[b as usize].as_dvec3();
+        for (wb, group) in Self::groups(adj, b, map) {
+            let (w, _) = attrs.optimal(&group, x, &adj.wedges[wb as usize]);
+            for &wa in &group[1..] {
+                attrs.merge(wb, wa);
+            }
+            adj.wedges[wb as usize] = w;
+            changes.push((wb, w));
+        }
+        changes
     }
 }
 
@@ -222,7 +290,7 @@ pub enum Stop {
 }
 
 /// One accepted collapse.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct Collapse {
     /// The vertex removed.
     pub from: u32,
@@ -234,6 +302,8 @@ pub struct Collapse {
     pub error: f64,
     /// Triangles after it.
     pub triangles: usize,
+    /// New attribute values of the surviving wedges.
+    pub attributes: Vec<(u32, Wedge)>,
 }
 
 /// The start mesh and the collapse sequence: any prefix is a LOD.
@@ -268,6 +338,9 @@ impl Progressive {
             }
             adj.collapse(c.from, c.to, c.position)
                 .expect("a recorded collapse replays");
+            for (w, v) in &c.attributes {
+                adj.wedges[*w as usize] = *v;
+            }
         }
         adj
     }
@@ -346,8 +419,9 @@ pub fn run(adj: Adjacency, cost: &mut dyn CollapseCost, stop: Stop, diagonal: f6
         } else {
             continue;
         };
+        let map = adj.collapse_wedge_map(from, to).expect("checked");
         adj.collapse(from, to, p).expect("checked");
-        cost.collapsed(&adj, from, to);
+        let attributes = cost.collapsed(&mut adj, from, to, &map);
         version[from as usize] += 1;
         version[to as usize] += 1;
         collapses.push(Collapse {
@@ -356,6 +430,7 @@ pub fn run(adj: Adjacency, cost: &mut dyn CollapseCost, stop: Stop, diagonal: f6
             position: p,
             error: err,
             triangles: adj.triangle_count(),
+            attributes,
         });
         // Only the edges around `to` changed (its quadric and position); their old entries
         // carry `to`'s old version and are skipped when popped.
@@ -373,8 +448,9 @@ pub fn run(adj: Adjacency, cost: &mut dyn CollapseCost, stop: Stop, diagonal: f6
 /// Simplify a mesh with QEM to `stop`; returns the LOD and the largest collapse error (model units).
 pub fn simplify(mesh: &Mesh, stop: Stop) -> Result<(Mesh, f64)> {
     let adj = Adjacency::new(mesh);
-    let mut cost = QemCost::new(&adj);
-    let pm = run(adj, &mut cost, stop, mesh.aabb().diagonal() as f64);
+    let diagonal = mesh.aabb().diagonal() as f64;
+    let mut cost = QemCost::with_attributes(&adj, diagonal);
+    let pm = run(adj, &mut cost, stop, diagonal);
     let target = match stop {
         Stop::Triangles(n) => n,
         Stop::RelativeError(_) => 0,
