@@ -342,7 +342,9 @@ pub struct DiffResult {
     pub width: usize,
     /// Image height.
     pub height: usize,
-    /// FLIP only: percentiles p25, p50, p75, p95, p99 and the maximum of the error map.
+    /// FLIP only: percentiles p25, p50, p75, p95, p99 and the maximum of the error map, and FLIP's
+    /// weighted percentiles (`weighted_p25`, `weighted_median`, `weighted_p75`; each error weighted
+    /// by itself, as NVIDIA's tool reports them).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub percentiles: Option<std::collections::BTreeMap<String, f64>>,
     /// VDP only: the difference in just-noticeable differences.
@@ -425,6 +427,10 @@ pub fn diff(
                     for q in [25.0, 50.0, 75.0, 95.0, 99.0] {
                         p.insert(format!("p{q}"), pool::percentile(v, q));
                     }
+                    // FLIP's weighted percentiles (what NVIDIA's tool reports).
+                    p.insert("weighted_p25".into(), pool::weighted_percentile(v, 0.25));
+                    p.insert("weighted_median".into(), pool::weighted_percentile(v, 0.5));
+                    p.insert("weighted_p75".into(), pool::weighted_percentile(v, 0.75));
                     p.insert("max".into(), pool::max(v));
                     r.value = Some(s.mean);
                     r.percentiles = Some(p);

@@ -31,6 +31,26 @@ pub fn percentile(values: &[f32], p: f64) -> f64 {
     sorted[lo] as f64 * (1.0 - t) + sorted[hi] as f64 * t
 }
 
+/// FLIP's weighted percentile (`p` in 0..=1): each value weighted by itself, so larger errors
+/// count more — the value at which the running sum of the ascending-sorted values first exceeds
+/// `p` × the total (the reference tool's "weighted median" for p = 0.5 and "weighted quartiles").
+/// Accumulated in `f32` like the reference (total in pixel order, running sum in sorted order);
+/// 0 when no value exceeds the threshold (e.g. an all-zero map).
+pub fn weighted_percentile(values: &[f32], p: f64) -> f64 {
+    let total: f32 = values.iter().sum();
+    let threshold = p as f32 * total;
+    let mut sorted = values.to_vec();
+    sorted.par_sort_unstable_by(|a, b| a.total_cmp(b));
+    let mut running = 0f32;
+    for v in sorted {
+        running += v;
+        if running > threshold {
+            return v as f64;
+        }
+    }
+    0.0
+}
+
 /// Largest value.
 pub fn max(values: &[f32]) -> f64 {
     values.iter().fold(f32::NEG_INFINITY, |m, &v| m.max(v)) as f64
