@@ -224,18 +224,14 @@ pub fn summary_table(outcome: &Outcome) -> String {
         None => "-".into(),
     };
     for l in &r.lods {
-        let worst = |m: &str| r.worst(&l.asset, &l.lod, m).map(|w| w.1);
-        let dist = r
-            .distances
-            .iter()
-            .find(|d| d.asset == l.asset && d.lod == l.lod && d.criterion.starts_with("vdp"))
-            .map(|d| {
-                format!(
-                    "{}{:.2}",
-                    if d.resolved { "" } else { "~" },
-                    d.imperceptible_beyond_m
-                )
-            });
+        let hl = r.headline(&l.asset, &l.lod);
+        let dist = hl.distance.as_ref().map(|d| {
+            format!(
+                "{}{:.2}",
+                if d.resolved { "" } else { "~" },
+                d.imperceptible_beyond_m
+            )
+        });
         let failed = outcome
             .failures
             .iter()
@@ -246,10 +242,10 @@ pub fn summary_table(outcome: &Outcome) -> String {
             l.lod,
             l.triangles,
             l.triangles as f64 / l.original_triangles.max(1) as f64,
-            fmt(r.mean(&l.asset, &l.lod, "flip"), 4),
-            fmt(worst("flip"), 4),
-            fmt(worst("psnr"), 2),
-            fmt(worst("vdp"), 3),
+            fmt(hl.flip_mean, 4),
+            fmt(hl.flip_worst, 4),
+            fmt(hl.psnr_worst, 2),
+            fmt(hl.vdp_worst, 3),
             dist.unwrap_or_else(|| "-".into()),
             if failed { "FAIL" } else { "pass" }
         ));

@@ -86,10 +86,8 @@ pub fn render(plan: &Plan, results: &Results, failures: &[Failure]) -> String {
         );
         h.push_str("<table><tr><th>LOD</th><th>triangles</th><th>ratio</th><th>FLIP mean</th><th>FLIP worst view</th><th>SSIM worst</th><th>PSNR worst (dB)</th><th>VDP p worst</th><th>imperceptible beyond (m)</th><th>Unity screen height</th><th>engine switch (m)</th><th>gate</th></tr>\n");
         for l in &lods {
-            let worst = |m: &str| results.worst(&asset.name, &l.lod, m).map(|w| w.1);
-            let dist: Option<&DistanceRow> = results.distances.iter().find(|d| {
-                d.asset == asset.name && d.lod == l.lod && d.criterion.starts_with("vdp")
-            });
+            let hl = results.headline(&asset.name, &l.lod);
+            let dist: Option<&DistanceRow> = hl.distance.as_ref();
             let bad = failing.contains(&(asset.name.as_str(), l.lod.as_str()));
             let _ = writeln!(
                 h,
@@ -98,11 +96,11 @@ pub fn render(plan: &Plan, results: &Results, failures: &[Failure]) -> String {
                 esc(&l.lod),
                 l.triangles,
                 l.triangles as f64 / l.original_triangles.max(1) as f64,
-                num(results.mean(&asset.name, &l.lod, "flip"), 4),
-                num(worst("flip"), 4),
-                num(worst("ssim"), 4),
-                num(worst("psnr"), 2),
-                num(worst("vdp"), 3),
+                num(hl.flip_mean, 4),
+                num(hl.flip_worst, 4),
+                num(hl.ssim_worst, 4),
+                num(hl.psnr_worst, 2),
+                num(hl.vdp_worst, 3),
                 num(dist.map(|d| d.imperceptible_beyond_m), 2),
                 if dist.is_some_and(|d| !d.resolved) {
                     " (bound)"

@@ -132,6 +132,23 @@ pub struct Results {
     pub distances: Vec<DistanceRow>,
 }
 
+/// One LOD's headline figures (see [`Results::headline`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Headline {
+    /// FLIP mean over views.
+    pub flip_mean: Option<f64>,
+    /// FLIP mean of the worst view.
+    pub flip_worst: Option<f64>,
+    /// SSIM of the worst view.
+    pub ssim_worst: Option<f64>,
+    /// PSNR of the worst view.
+    pub psnr_worst: Option<f64>,
+    /// VDP detection probability of the worst view.
+    pub vdp_worst: Option<f64>,
+    /// The VDP-criterion distance row.
+    pub distance: Option<DistanceRow>,
+}
+
 /// Whether larger values of `metric` mean a larger difference.
 pub fn higher_is_worse(metric: &str) -> bool {
     !matches!(metric, "ssim" | "msssim" | "psnr")
@@ -228,6 +245,23 @@ impl Results {
                 Some((_, b)) if (worse && r.value <= b) || (!worse && r.value >= b) => best,
                 _ => Some((r.view, r.value)),
             })
+    }
+
+    /// The headline figures of one LOD, as the summary table and the report show them.
+    pub fn headline(&self, asset: &str, lod: &str) -> Headline {
+        let worst = |m: &str| self.worst(asset, lod, m).map(|w| w.1);
+        Headline {
+            flip_mean: self.mean(asset, lod, "flip"),
+            flip_worst: worst("flip"),
+            ssim_worst: worst("ssim"),
+            psnr_worst: worst("psnr"),
+            vdp_worst: worst("vdp"),
+            distance: self
+                .distances
+                .iter()
+                .find(|d| d.asset == asset && d.lod == lod && d.criterion.starts_with("vdp"))
+                .cloned(),
+        }
     }
 
     /// The mean over views of `metric` for one LOD.

@@ -32,6 +32,26 @@ fn finish(name: &str, positions: Vec<Vec3>, triangles: Vec<[u32; 3]>) -> Mesh {
     Mesh::new(data, &LoadOptions::DEFAULT).expect("procedural meshes are valid by construction")
 }
 
+/// An n×n grid of unit squares in the plane z = 0 (two triangles each), corners (0, 0) and
+/// (n, n): an open mesh with a border.
+pub fn grid_plane(n: u32) -> Mesh {
+    let n = n.max(1);
+    let positions = (0..=n)
+        .flat_map(|y| (0..=n).map(move |x| Vec3::new(x as f32, y as f32, 0.0)))
+        .collect();
+    let id = |x: u32, y: u32| y * (n + 1) + x;
+    let triangles = (0..n)
+        .flat_map(|y| (0..n).map(move |x| (x, y)))
+        .flat_map(|(x, y)| {
+            [
+                [id(x, y), id(x + 1, y), id(x + 1, y + 1)],
+                [id(x, y), id(x + 1, y + 1), id(x, y + 1)],
+            ]
+        })
+        .collect();
+    finish("plane", positions, triangles)
+}
+
 /// The cube [−1, 1]³ with each face an n×n grid of squares (two triangles each), vertices shared
 /// along the cube's edges, counter-clockwise seen from outside.
 pub fn cube_grid(n: u32) -> Mesh {

@@ -462,50 +462,14 @@ pub fn simplify(mesh: &Mesh, stop: Stop) -> Result<(Mesh, f64)> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::mesh::{LoadOptions, MeshData, Source, shapes};
-
-    fn grid_plane(n: u32) -> Mesh {
-        // An n×n grid of unit squares in z = 0, two triangles each.
-        let mut positions = Vec::new();
-        for y in 0..=n {
-            for x in 0..=n {
-                positions.push(Vec3::new(x as f32, y as f32, 0.0));
-            }
-        }
-        let mut triangles = Vec::new();
-        let id = |x: u32, y: u32| y * (n + 1) + x;
-        for y in 0..n {
-            for x in 0..n {
-                triangles.push([id(x, y), id(x + 1, y), id(x + 1, y + 1)]);
-                triangles.push([id(x, y), id(x + 1, y + 1), id(x, y + 1)]);
-            }
-        }
-        let data = MeshData {
-            positions,
-            normals: None,
-            uvs: None,
-            colors: None,
-            triangles,
-            material_ids: Vec::new(),
-            materials: Vec::new(),
-            source: Source {
-                path: "plane".into(),
-                format: crate::mesh::Format::Obj,
-                file_vertices: 0,
-                file_faces: 0,
-                file_unreferenced: 0,
-            },
-            warnings: Vec::new(),
-        };
-        Mesh::new(data, &LoadOptions::default()).unwrap()
-    }
+    use crate::mesh::{LoadOptions, shapes};
 
     #[test]
     fn a_tessellated_plane_collapses_to_two_triangles_with_zero_error() {
         // Every plane quadric is the same plane and the border constraint planes pass through
         // the border, so interior and border vertices collapse at zero cost until only the four
         // corners (where two border planes meet, so moving them costs) remain.
-        let m = grid_plane(8);
+        let m = shapes::grid_plane(8);
         let (lod, err) = simplify(&m, Stop::Triangles(2)).unwrap();
         assert_eq!(lod.triangle_count(), 2);
         assert!(err < 1e-9, "{err}");
