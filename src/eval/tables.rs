@@ -149,6 +149,18 @@ pub struct Headline {
     pub distance: Option<DistanceRow>,
 }
 
+/// The (view, value) with the worst value — the largest if `higher_is_worse`, else the smallest;
+/// the first such view on ties.
+fn worst_of(
+    values: impl Iterator<Item = (usize, f64)>,
+    higher_is_worse: bool,
+) -> Option<(usize, f64)> {
+    values.fold(None, |best, (view, v)| match best {
+        Some((_, b)) if (higher_is_worse && v <= b) || (!higher_is_worse && v >= b) => best,
+        _ => Some((view, v)),
+    })
+}
+
 /// Whether larger values of `metric` mean a larger difference.
 pub fn higher_is_worse(metric: &str) -> bool {
     !matches!(metric, "ssim" | "msssim" | "psnr")
@@ -213,13 +225,7 @@ impl Results {
             });
             let vals: Vec<f64> = values.iter().map(|v| v.1).collect();
             let worse = higher_is_worse(&metric);
-            let worst_view = values
-                .iter()
-                .fold(None::<(usize, f64)>, |best, &(view, v)| match best {
-                    Some((_, b)) if (worse && v <= b) || (!worse && v >= b) => best,
-                    _ => Some((view, v)),
-                })
-                .map_or(0, |b| b.0);
+            let worst_view = worst_of(values.iter().copied(), worse).map_or(0, |b| b.0);
             out.push(SummaryRow {
                 asset,
                 lod,
@@ -237,14 +243,13 @@ impl Results {
 
     /// The worst per-view value of `metric` for one LOD, in the metric's direction.
     pub fn worst(&self, asset: &str, lod: &str, metric: &str) -> Option<(usize, f64)> {
-        let worse = higher_is_worse(metric);
-        self.rows
-            .iter()
-            .filter(|r| r.asset == asset && r.lod == lod && r.metric == metric)
-            .fold(None, |best: Option<(usize, f64)>, r| match best {
-                Some((_, b)) if (worse && r.value <= b) || (!worse && r.value >= b) => best,
-                _ => Some((r.view, r.value)),
-            })
+        worst_of(
+            self.rows
+                .iter()
+                .filter(|r| r.asset == asset && r.lod == lod && r.metric == metric)
+                .map(|r| (r.view, r.value)),
+            higher_is_worse(metric),
+        )
     }
 
     /// The headline figures of one LOD, as the summary table and the report show them.
