@@ -182,7 +182,18 @@ impl AttributeQuadrics {
             }
         }
         let off = n * (n + 1) / 2;
-        let a = |i: usize, j: usize| q[tri_index(n, i, j)];
+        // Unpack the symmetric matrix once (the packed index arithmetic per access cost more than
+        // the solve).
+        let mut full = [[0.0f64; MAX_N]; MAX_N];
+        let mut k = 0;
+        for i in 0..n {
+            for j in i..n {
+                full[i][j] = q[k];
+                full[j][i] = q[k];
+                k += 1;
+            }
+        }
+        let a = |i: usize, j: usize| full[i][j];
         // Solve A_aa · a = −(A_ax · x + b_a) by Cholesky.
         let mut l = [[0.0f64; MAX_M]; MAX_M];
         let mut rhs = [0.0f64; MAX_M];
@@ -235,10 +246,8 @@ impl AttributeQuadrics {
         // Value at v.
         let mut val = q[off + n];
         for i in 0..n {
-            val += 2.0 * q[off + i] * v[i];
-            for j in 0..n {
-                val += a(i, j) * v[i] * v[j];
-            }
+            let row: f64 = (0..n).map(|j| full[i][j] * v[j]).sum();
+            val += v[i] * (row + 2.0 * q[off + i]);
         }
         (self.wedge_from(&v[3..], keep), val.max(0.0))
     }
