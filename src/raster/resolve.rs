@@ -52,10 +52,20 @@ impl Pass {
     ) -> Pass {
         let mesh = scene.mesh();
         let (mvp, depth_range) = camera_setup(camera, settings.width, settings.height);
+        let offsets = settings.samples.offsets();
+        let span = |k: usize, f: fn(i64, i64) -> i64| {
+            offsets.iter().map(|o| o[k]).reduce(f).unwrap_or(0) as i32
+        };
         let vp = Viewport {
             width: settings.width,
             height: settings.height,
             cull_backfaces: settings.cull_backfaces,
+            sample_span: [
+                span(0, i64::min),
+                span(1, i64::min),
+                span(0, i64::max),
+                span(1, i64::max),
+            ],
         };
         let planes = ClipPlanes::for_viewport(settings.width, settings.height);
         // Stage 1: transform, classify and project vertices.
@@ -70,7 +80,7 @@ impl Pass {
             planes,
             xf,
             binned,
-            offsets: settings.samples.offsets(),
+            offsets,
             count_coverage,
             lights: scene
                 .lights

@@ -71,6 +71,8 @@ pub(crate) struct Viewport {
     pub width: u32,
     pub height: u32,
     pub cull_backfaces: bool,
+    /// The sample positions' extent within a pixel, Fx24_8: [min x, min y, max x, max y].
+    pub sample_span: [i32; 4],
 }
 
 /// A vertex after transformation: its clip-space position, the clip planes it is outside of and,
@@ -217,12 +219,19 @@ fn emit(
     let max_x = v.iter().map(|p| p[0]).max().unwrap_or(0);
     let min_y = v.iter().map(|p| p[1]).min().unwrap_or(0);
     let max_y = v.iter().map(|p| p[1]).max().unwrap_or(0);
-    let px = |f: i32| f >> super::fixed::SUBPIXEL_BITS; // floor to pixel
+    // The pixels that have a sample inside the vertices' bounding box: pixel x has samples at
+    // x·256 + o for o in [span min, span max], so it can only be covered if
+    // x·256 + max ≥ min_x and x·256 + min ≤ max_x. A triangle between sample positions (common
+    // for sub-pixel triangles at one sample per pixel) gets an empty box and is dropped here,
+    // before binning; coverage is exactly the same.
+    let one = super::fixed::ONE_PIXEL as i32;
+    let [sx0, sy0, sx1, sy1] = vp.sample_span;
+    let ceil_div = |a: i32| -((-a).div_euclid(one));
     let bbox = [
-        px(min_x).max(0),
-        px(min_y).max(0),
-        (px(max_x) + 1).min(vp.width as i32),
-        (px(max_y) + 1).min(vp.height as i32),
+        ceil_div(min_x - sx1).max(0),
+        ceil_div(min_y - sy1).max(0),
+        ((max_x - sx0).div_euclid(one) + 1).min(vp.width as i32),
+        ((max_y - sy0).div_euclid(one) + 1).min(vp.height as i32),
     ];
     if bbox[0] >= bbox[2] || bbox[1] >= bbox[3] {
         return;
