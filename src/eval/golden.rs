@@ -65,15 +65,15 @@ pub fn run(plan: &Plan, bless: bool, ci: bool, out_dir: &Path) -> Result<GoldenO
     for asset in &plan.assets {
         let original = Arc::new(mesh::load(&asset.mesh, &LoadOptions::default())?);
         let cameras = crate::commands::rig_cameras(&original, &cfg.render.rig.0, 1.0);
-        let mut meshes: Vec<(String, Mesh)> = vec![("original".into(), (*original).clone())];
+        let mut meshes: Vec<(String, Arc<Mesh>)> = vec![("original".into(), original.clone())];
         if cfg.golden.lods {
             let all = vec![true; asset.lods.len()];
             for (name, m, _) in super::run::build_lods(asset, &original, &all)? {
-                meshes.push((name, m));
+                meshes.push((name, Arc::new(m)));
             }
         }
         for (name, m) in meshes {
-            let scene = super::run::scene_for(cfg, Arc::new(m));
+            let scene = super::run::scene_for(cfg, m);
             for (v, cam) in cameras.iter().enumerate() {
                 let rel = Path::new(&asset.name)
                     .join(&name)

@@ -1,5 +1,5 @@
-//! The batch run behind `lodeval eval`: load each asset and its LODs (files or the meshoptimizer
-//! chain), render the original once per view as the metric reference, render every LOD from the
+//! The batch run behind `lodeval eval`: load each asset and its LODs (files, or a generated chain
+//! from `simplify::chain`: meshoptimizer, QEM or clustering), measure their geometric error, render the original once per view as the metric reference, render every LOD from the
 //! same camera, score, write heat maps and contact sheets, search the imperceptibility distances,
 //! then hand the tables to the sinks (CSV, gate, JUnit, report).
 //!

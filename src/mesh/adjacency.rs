@@ -148,28 +148,11 @@ impl Adjacency {
     }
 
     fn classify(&mut self) {
-        let mut edges: BTreeMap<(u32, u32), Vec<u32>> = BTreeMap::new();
-        for t in self.live_triangles() {
-            let tri = self.tris[t as usize];
-            for k in 0..3 {
-                let (a, b) = (tri[k], tri[(k + 1) % 3]);
-                edges.entry((a.min(b), a.max(b))).or_default().push(t);
-            }
-        }
-        for ((a, b), ts) in &edges {
+        for ((a, b), ts) in &self.edge_map() {
             let c = match ts.len() {
                 1 => VertexClass::Border,
-                2 => {
-                    let w = |t: u32, v: u32| {
-                        let k = self.tris[t as usize].iter().position(|&x| x == v).unwrap();
-                        self.corners[t as usize][k]
-                    };
-                    if w(ts[0], *a) != w(ts[1], *a) || w(ts[0], *b) != w(ts[1], *b) {
-                        VertexClass::Seam
-                    } else {
-                        VertexClass::Interior
-                    }
-                }
+                2 if self.is_seam(*a, *b, ts) => VertexClass::Seam,
+                2 => VertexClass::Interior,
                 _ => VertexClass::NonManifold,
             };
             for v in [*a, *b] {
@@ -198,10 +181,7 @@ impl Adjacency {
     pub fn vertex_wedges(&self, v: u32) -> Vec<u32> {
         let mut w: Vec<u32> = self.vtris[v as usize]
             .iter()
-            .map(|&t| {
-                let k = self.tris[t as usize].iter().position(|&x| x == v).unwrap();
-                self.corners[t as usize][k]
-            })
+            .map(|&t| self.corner_wedge(t, v))
             .collect();
         w.sort_unstable();
         w.dedup();
@@ -215,6 +195,32 @@ impl Adjacency {
             return Err(Reject::NoSuchEdge);
         }
         self.wedge_map(a, b, &shared)
+    }
+
+    /// The wedge of `v`'s corner in triangle `t` (which must use `v`).
+    pub fn corner_wedge(&self, t: u32, v: u32) -> u32 {
+        let k = self.tris[t as usize].iter().position(|&x| x == v).unwrap();
+        self.corners[t as usize][k]
+    }
+
+    /// Every live edge (a < b) with its live triangles, in edge order.
+    pub fn edge_map(&self) -> BTreeMap<(u32, u32), Vec<u32>> {
+        let mut edges: BTreeMap<(u32, u32), Vec<u32>> = BTreeMap::new();
+        for t in self.live_triangles() {
+            let x = self.tris[t as usize];
+            for k in 0..3 {
+                let (a, b) = (x[k], x[(k + 1) % 3]);
+                edges.entry((a.min(b), a.max(b))).or_default().push(t);
+            }
+        }
+        edges
+    }
+
+    /// Whether the edge ab between triangles `ts` (two of them) is a seam: a or b has different
+    /// wedges on its two sides.
+    pub fn is_seam(&self, a: u32, b: u32, ts: &[u32]) -> bool {
+        let w = |t: u32, v: u32| self.corner_wedge(t, v);
+        w(ts[0], a) != w(ts[1], a) || w(ts[0], b) != w(ts[1], b)
     }
 
     /// Forbid moving vertex `v`.
@@ -402,8 +408,7 @@ impl Adjacency {
             }
         }
         for &t in &self.vtris[a as usize] {
-            let k = self.tris[t as usize].iter().position(|&x| x == a).unwrap();
-            let w = self.corners[t as usize][k];
+            let w = self.corner_wedge(t, a);
             if !map.iter().any(|(x, _)| *x == w) {
                 return Err(Reject::Seam);
             }
@@ -559,13 +564,10 @@ impl Adjacency {
         if c == d || !self.edge_triangles(c, d).is_empty() {
             return Err(Reject::Topology);
         }
-        let w = |t: u32, v: u32| {
-            let k = self.tris[t as usize].iter().position(|&x| x == v).unwrap();
-            self.corners[t as usize][k]
-        };
-        if w(t1, a) != w(t2, a) || w(t1, b) != w(t2, b) {
+        if self.is_seam(a, b, &[t1, t2]) {
             return Err(Reject::Seam);
         }
+        let w = |t: u32, v: u32| self.corner_wedge(t, v);
         if self.locked[a as usize] || self.locked[b as usize] {
             return Err(Reject::Locked);
         }
@@ -671,28 +673,12 @@ impl Adjacency {
 
     /// Edges used by more than two live triangles.
     pub fn non_manifold_edges(&self) -> usize {
-        let mut edges: BTreeMap<(u32, u32), usize> = BTreeMap::new();
-        for t in self.live_triangles() {
-            let x = self.tris[t as usize];
-            for k in 0..3 {
-                let (a, b) = (x[k], x[(k + 1) % 3]);
-                *edges.entry((a.min(b), a.max(b))).or_default() += 1;
-            }
-        }
-        edges.values().filter(|&&c| c > 2).count()
+        self.edge_map().values().filter(|ts| ts.len() > 2).count()
     }
 
     /// Border edges (one live triangle).
     pub fn border_edges(&self) -> usize {
-        let mut edges: BTreeMap<(u32, u32), usize> = BTreeMap::new();
-        for t in self.live_triangles() {
-            let x = self.tris[t as usize];
-            for k in 0..3 {
-                let (a, b) = (x[k], x[(k + 1) % 3]);
-                *edges.entry((a.min(b), a.max(b))).or_default() += 1;
-            }
-        }
-        edges.values().filter(|&&c| c == 1).count()
+        self.edge_map().values().filter(|ts| ts.len() == 1).count()
     }
 
     /// The current mesh: one output vertex per used wedge, at its welded vertex's position.

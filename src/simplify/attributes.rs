@@ -299,10 +299,7 @@ mod tests {
         let wedges: Vec<u32> = adj
             .vertex_triangles(v)
             .iter()
-            .map(|&t| {
-                let k = adj.triangle(t).iter().position(|&x| x == v).unwrap();
-                adj.corners(t)[k]
-            })
+            .map(|&t| adj.corner_wedge(t, v))
             .collect();
         let keep = adj.wedges[wedges[0] as usize];
         let (w, val) = q.optimal(&wedges, adj.positions[v as usize].as_dvec3(), &keep);

@@ -155,7 +155,6 @@ fn chain_of(mesh: &Mesh, method: Method, goals: &[Goal]) -> Result<Vec<Lod>> {
         Goal::Triangles(t) => Some(t),
         Goal::Error(_) => None,
     };
-    let diagonal = mesh.aabb().diagonal() as f64;
     match method {
         Method::Meshopt => {
             let mut out: Vec<Lod> = Vec::new();
@@ -179,11 +178,7 @@ fn chain_of(mesh: &Mesh, method: Method, goals: &[Goal]) -> Result<Vec<Lod>> {
         }
         Method::Qem => {
             let smallest = goals.iter().filter_map(|&g| tris(g)).min();
-            let progressive = smallest.map(|t| {
-                let adj = crate::mesh::adjacency::Adjacency::new(mesh);
-                let mut cost = qem::QemCost::with_attributes(&adj, diagonal);
-                qem::run(adj, &mut cost, qem::Stop::Triangles(t), diagonal)
-            });
+            let progressive = smallest.map(|t| qem::progressive(mesh, qem::Stop::Triangles(t)));
             goals
                 .iter()
                 .map(|&g| match (tris(g), &progressive, g) {

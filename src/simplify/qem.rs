@@ -149,7 +149,6 @@ impl QemCost {
     pub fn new(adj: &Adjacency) -> QemCost {
         let mut q = vec![Quadric::default(); adj.positions.len()];
         let pos = |v: u32| adj.positions[v as usize].as_dvec3();
-        let mut edge_tris: std::collections::BTreeMap<(u32, u32), Vec<u32>> = Default::default();
         for t in adj.live_triangles() {
             let [a, b, c] = adj.triangle(t);
             let n = (pos(b) - pos(a)).cross(pos(c) - pos(a));
@@ -161,24 +160,11 @@ impl QemCost {
                     q[v as usize] = q[v as usize].add(&k);
                 }
             }
-            for (x, y) in [(a, b), (b, c), (c, a)] {
-                edge_tris.entry((x.min(y), x.max(y))).or_default().push(t);
-            }
         }
-        for ((x, y), ts) in edge_tris {
+        for ((x, y), ts) in adj.edge_map() {
             let weight = match ts.len() {
                 1 => BORDER_WEIGHT,
-                2 => {
-                    let w = |t: u32, v: u32| {
-                        let k = adj.triangle(t).iter().position(|&u| u == v).unwrap();
-                        adj.corners(t)[k]
-                    };
-                    if w(ts[0], x) != w(ts[1], x) || w(ts[0], y) != w(ts[1], y) {
-                        SEAM_WEIGHT
-                    } else {
-                        continue;
-                    }
-                }
+                2 if adj.is_seam(x, y, &ts) => SEAM_WEIGHT,
                 _ => continue,
             };
             let [a, b, c] = adj.triangle(ts[0]);
@@ -445,12 +431,17 @@ pub fn run(adj: Adjacency, cost: &mut dyn CollapseCost, stop: Stop, diagonal: f6
     }
 }
 
-/// Simplify a mesh with QEM to `stop`; returns the LOD and the largest collapse error (model units).
-pub fn simplify(mesh: &Mesh, stop: Stop) -> Result<(Mesh, f64)> {
+/// The progressive record of `mesh` down to `stop`, with attribute-aware quadrics.
+pub fn progressive(mesh: &Mesh, stop: Stop) -> Progressive {
     let adj = Adjacency::new(mesh);
     let diagonal = mesh.aabb().diagonal() as f64;
     let mut cost = QemCost::with_attributes(&adj, diagonal);
-    let pm = run(adj, &mut cost, stop, diagonal);
+    run(adj, &mut cost, stop, diagonal)
+}
+
+/// Simplify a mesh with QEM to `stop`; returns the LOD and the largest collapse error (model units).
+pub fn simplify(mesh: &Mesh, stop: Stop) -> Result<(Mesh, f64)> {
+    let pm = progressive(mesh, stop);
     let target = match stop {
         Stop::Triangles(n) => n,
         Stop::RelativeError(_) => 0,
