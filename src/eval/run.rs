@@ -97,11 +97,13 @@ pub fn run(plan: Plan, options: &RunOptions) -> Result<RunOutput> {
         bar.set_message(asset.name.clone());
         let original = Arc::new(mesh::load(&asset.mesh, &LoadOptions::default())?);
         let reference = scene_for(cfg, original.clone());
+        let geometry = (cfg.geometry_samples > 0)
+            .then(|| surface_distance::Original::new(&original, cfg.geometry_samples));
         let lods = build_lods(asset, &original, &wanted)?
             .into_iter()
             .map(|(name, mesh, mut info)| {
-                if cfg.geometry_samples > 0 {
-                    let d = surface_distance::compare(&original, &mesh, cfg.geometry_samples);
+                if let Some(g) = &geometry {
+                    let d = g.compare(&mesh);
                     info.hausdorff = Some(round7(d.hausdorff));
                     info.mean_distance = Some(round7(d.mean));
                     info.rms_distance = Some(round7(d.rms));

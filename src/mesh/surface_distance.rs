@@ -245,11 +245,48 @@ fn one_sided(samples: &[Vec3], to: &ClosestPoint) -> (f64, f64, f64) {
 
 /// Compare `a` (the original) with `b`, with about `face_samples` face samples on each.
 pub fn compare(a: &Mesh, b: &Mesh, face_samples: usize) -> SurfaceDistance {
-    let (ta, tb) = (ClosestPoint::new(a), ClosestPoint::new(b));
-    let (sa, sb) = (samples(a, face_samples), samples(b, face_samples));
-    let (max_ab, mean_ab, rms_ab) = one_sided(&sa, &tb);
-    let (max_ba, mean_ba, rms_ba) = one_sided(&sb, &ta);
-    let diagonal = a.aabb().diagonal() as f64;
+    Original::new(a, face_samples).compare(b)
+}
+
+/// The original's half of a comparison (its tree, samples and diagonal), built once and reused
+/// for every LOD of it.
+#[derive(Debug)]
+pub struct Original {
+    tree: ClosestPoint,
+    samples: Vec<Vec3>,
+    diagonal: f64,
+    face_samples: usize,
+}
+
+impl Original {
+    /// Prepare `a` with about `face_samples` face samples (the same number is taken on each LOD).
+    pub fn new(a: &Mesh, face_samples: usize) -> Original {
+        Original {
+            tree: ClosestPoint::new(a),
+            samples: samples(a, face_samples),
+            diagonal: a.aabb().diagonal() as f64,
+            face_samples,
+        }
+    }
+
+    /// Compare the original with `b`.
+    pub fn compare(&self, b: &Mesh) -> SurfaceDistance {
+        let (sa, ta, diagonal) = (&self.samples, &self.tree, self.diagonal);
+        let (tb, sb) = (ClosestPoint::new(b), samples(b, self.face_samples));
+        let (max_ab, mean_ab, rms_ab) = one_sided(sa, &tb);
+        let (max_ba, mean_ba, rms_ba) = one_sided(&sb, ta);
+        summarise(
+            diagonal,
+            [sa.len(), sb.len()],
+            [max_ab, mean_ab, rms_ab],
+            [max_ba, mean_ba, rms_ba],
+        )
+    }
+}
+
+/// Pool the two one-sided (max, mean, rms) results.
+fn summarise(diagonal: f64, n: [usize; 2], ab: [f64; 3], ba: [f64; 3]) -> SurfaceDistance {
+    let ([max_ab, mean_ab, rms_ab], [max_ba, mean_ba, rms_ba]) = (ab, ba);
     let (h, mean, rms) = (max_ab.max(max_ba), mean_ab.max(mean_ba), rms_ab.max(rms_ba));
     let rel = |x: f64| if diagonal > 0.0 { x / diagonal } else { 0.0 };
     SurfaceDistance {
@@ -259,7 +296,7 @@ pub fn compare(a: &Mesh, b: &Mesh, face_samples: usize) -> SurfaceDistance {
         hausdorff_relative: rel(h),
         mean_relative: rel(mean),
         rms_relative: rel(rms),
-        samples: [sa.len(), sb.len()],
+        samples: n,
         one_sided_max: [max_ab, max_ba],
         one_sided_mean: [mean_ab, mean_ba],
     }
