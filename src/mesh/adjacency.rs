@@ -243,6 +243,21 @@ impl Adjacency {
         self.alive_count
     }
 
+    /// Triangle slots, live or not (triangle ids are below this).
+    pub fn triangle_slots(&self) -> usize {
+        self.tris.len()
+    }
+
+    /// Whether triangle `t` exists and is live.
+    pub fn is_alive(&self, t: u32) -> bool {
+        self.alive.get(t as usize).copied().unwrap_or(false)
+    }
+
+    /// A triangle's material.
+    pub fn material(&self, t: u32) -> u32 {
+        self.materials[t as usize]
+    }
+
     /// Ids of the live triangles, ascending.
     pub fn live_triangles(&self) -> impl Iterator<Item = u32> + '_ {
         (0..self.tris.len() as u32).filter(|&t| self.alive[t as usize])

@@ -46,6 +46,19 @@ impl TileSamples {
     }
 }
 
+impl TileSamples {
+    /// Reuse the buffers for `rect` (no coverage counting), cleared.
+    pub fn reset(&mut self, rect: [i32; 4]) {
+        let n = ((rect[2] - rect[0]) * (rect[3] - rect[1])) as usize * self.samples;
+        self.rect = rect;
+        self.depth.clear();
+        self.depth.resize(n, f32::INFINITY);
+        self.ids.clear();
+        self.ids.resize(n, EMPTY);
+        self.counts = None;
+    }
+}
+
 /// Rasterize set-up triangle `st` (index `id`) into `buf`, restricted to `clip` (a sub-rectangle
 /// of the tile, `[x0, y0, x1, y1)`). `offsets` are the sample positions within a pixel in Fx24_8.
 /// `scratch` must hold at least `offsets.len()` entries.

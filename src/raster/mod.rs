@@ -21,6 +21,7 @@ mod clip;
 mod edge;
 mod fixed;
 mod frame;
+pub mod luminance;
 mod prepare;
 mod region;
 mod resolve;
