@@ -686,3 +686,59 @@ pub fn bench_simplify(
     }
     Ok(rows)
 }
+
+/// What `lodeval optimize` does.
+#[derive(Debug, Clone)]
+pub struct OptimizeJob {
+    /// The original (target) mesh.
+    pub original: PathBuf,
+    /// The simplified mesh to improve.
+    pub simplified: PathBuf,
+    /// Output OBJ.
+    pub out: PathBuf,
+    /// Energy log CSV, if wanted.
+    pub energy_csv: Option<PathBuf>,
+    /// Optimizer settings.
+    pub options: crate::simplify::lindstrom_turk::Options,
+    /// Show a progress bar.
+    pub progress: bool,
+}
+
+/// Run the image-driven optimizer and write the mesh (and the energy log).
+pub fn optimize(job: &OptimizeJob) -> Result<crate::simplify::lindstrom_turk::Outcome> {
+    use crate::simplify::lindstrom_turk;
+    if job.out.extension().and_then(|e| e.to_str()) != Some("obj") {
+        return Err(Error::Usage(format!(
+            "-o {}: lodeval writes optimized meshes as .obj",
+            job.out.display()
+        )));
+    }
+    let original = std::sync::Arc::new(mesh::load(&job.original, &LoadOptions::default())?);
+    let simplified = std::sync::Arc::new(mesh::load(&job.simplified, &LoadOptions::default())?);
+    let bar = crate::eval::run::progress_bar(job.progress, job.options.evals, "evaluations");
+    let outcome = lindstrom_turk::optimize(&original, &simplified, &job.options, &|n| {
+        bar.set_position(n)
+    })?;
+    bar.finish_and_clear();
+    crate::mesh::write_obj::write(&outcome.mesh, &job.out)?;
+    if let Some(path) = &job.energy_csv {
+        write_energy_csv(path, &outcome.log)?;
+    }
+    Ok(outcome)
+}
+
+/// Write an energy log as CSV (evals, seconds, d_ms, relative), atomically.
+pub fn write_energy_csv(
+    path: &Path,
+    log: &[crate::simplify::lindstrom_turk::EnergyRow],
+) -> Result<()> {
+    let mut w = csv::Writer::from_writer(Vec::new());
+    for row in log {
+        w.serialize(row)
+            .map_err(|e| Error::Internal(format!("energy CSV: {e}")))?;
+    }
+    let bytes = w
+        .into_inner()
+        .map_err(|e| Error::Internal(format!("energy CSV: {e}")))?;
+    crate::io::write_atomic(path, &bytes)
+}

@@ -84,7 +84,7 @@ pub fn run(plan: Plan, options: &RunOptions) -> Result<RunOutput> {
         .count();
     let views = cfg.render.rig.0.directions().len();
     let steps = cases * (views + usize::from(cfg.distance.enabled));
-    let bar = progress_bar(options.progress, steps as u64);
+    let bar = progress_bar(options.progress, steps as u64, "renders");
     for asset in &plan.assets {
         let wanted: Vec<bool> = asset
             .lods
@@ -380,14 +380,15 @@ fn thumbnail(img: &image::RgbImage) -> image::RgbImage {
     image::imageops::resize(img, THUMB, THUMB, image::imageops::FilterType::Triangle)
 }
 
-fn progress_bar(enabled: bool, len: u64) -> indicatif::ProgressBar {
+/// A progress bar counting `unit`s, or a hidden one when not `enabled`.
+pub(crate) fn progress_bar(enabled: bool, len: u64, unit: &str) -> indicatif::ProgressBar {
     if !enabled {
         return indicatif::ProgressBar::hidden();
     }
     let bar = indicatif::ProgressBar::new(len);
-    if let Ok(style) = indicatif::ProgressStyle::with_template(
-        "{spinner} [{elapsed_precise}] {bar:40} {pos}/{len} renders  {msg}",
-    ) {
+    if let Ok(style) = indicatif::ProgressStyle::with_template(&format!(
+        "{{spinner}} [{{elapsed_precise}}] {{bar:40}} {{pos}}/{{len}} {unit}  {{msg}}"
+    )) {
         bar.set_style(style);
     }
     bar

@@ -87,6 +87,8 @@ struct View {
     tiles_x: u32,
     target: Vec<u16>,
     current: Vec<u16>,
+    /// Source triangle shown at each pixel (`u32::MAX`: background).
+    shown: Vec<u32>,
     trial: Trial,
 }
 
@@ -99,6 +101,7 @@ struct Trial {
     bbox: Vec<(u32, Option<[i32; 4]>)>,
     rect: Option<[i32; 4]>,
     pixels: Vec<u16>,
+    shown: Vec<u32>,
     /// Per source triangle: the trial number that changed it.
     stamp: Vec<u32>,
     number: u32,
@@ -249,6 +252,7 @@ impl LumaViews {
                         .and_then(|t| t.next())
                         .unwrap_or_default(),
                     current: vec![shared.background; n],
+                    shown: vec![u32::MAX; n],
                     trial: Trial::default(),
                 }
             })
@@ -535,27 +539,36 @@ impl View {
                 &mut scratch,
             );
         }
-        // Shade and compare.
+        // Shade and compare. A pixel that still shows the same unchanged triangle keeps its
+        // value (that triangle's corners and attributes are as committed); only pixels showing a
+        // changed triangle, or a different one than before, are shaded.
         let [x0, y0, x1, y1] = rect;
         let w = shared.width as usize;
         tr.pixels.clear();
+        tr.shown.clear();
         let mut delta = 0i64;
         for y in y0..y1 {
             for x in x0..x1 {
                 let k = ((y - y0) * (x1 - x0) + (x - x0)) as usize;
+                let i = y as usize * w + x as usize;
                 let id = samples.ids[k];
-                let luma = if id == EMPTY {
-                    shared.background
+                let (luma, tri) = if id == EMPTY {
+                    (shared.background, u32::MAX)
                 } else {
                     let c = &tr.candidates[id as usize];
-                    let p = piece(c);
-                    shade(shared, mesh, &self.light, c.0, p, x as f64 + 0.5, y as f64 + 0.5)
+                    if !c.2 && self.shown[i] == c.0 && !everything {
+                        (self.current[i], c.0)
+                    } else {
+                        let p = piece(c);
+                        let x = x as f64 + 0.5;
+                        (shade(shared, mesh, &self.light, c.0, p, x, y as f64 + 0.5), c.0)
+                    }
                 };
-                let i = y as usize * w + x as usize;
                 if !self.target.is_empty() {
                     delta += sq(self.target[i], luma) - sq(self.target[i], self.current[i]);
                 }
                 tr.pixels.push(luma);
+                tr.shown.push(tri);
             }
         }
         delta
@@ -600,6 +613,7 @@ impl View {
             for (row, y) in (y0..y1).enumerate() {
                 let dst = y as usize * w + x0 as usize;
                 self.current[dst..dst + rw].copy_from_slice(&tr.pixels[row * rw..(row + 1) * rw]);
+                self.shown[dst..dst + rw].copy_from_slice(&tr.shown[row * rw..(row + 1) * rw]);
             }
         }
         tr.saved_xf.clear();

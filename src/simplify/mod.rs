@@ -6,6 +6,7 @@
 
 pub mod attributes;
 pub mod cluster;
+pub mod lindstrom_turk;
 pub mod meshopt;
 pub mod qem;
 

@@ -1,4 +1,4 @@
-//! The command line end to end: exit codes, output shapes, and honest "not built yet" answers.
+//! The command line end to end: exit codes, output shapes, and usage errors.
 
 use crate::common::{lodeval, model};
 
@@ -50,14 +50,6 @@ fn zero_threads_is_a_usage_error() {
     let r = lodeval(["--threads", "0", "info", "x.obj"]);
     assert_eq!(r.code, 2);
     assert!(r.stderr.contains("--threads"), "{}", r.stderr);
-}
-
-#[test]
-fn unbuilt_subcommands_say_so_and_exit_2() {
-    let r = lodeval(["optimize", "whatever", "--flag"]);
-    assert_eq!(r.code, 2, "{}", r.stderr);
-    assert!(r.stderr.contains("not built yet"), "{}", r.stderr);
-    assert!(r.stdout.is_empty());
 }
 
 #[test]

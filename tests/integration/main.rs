@@ -1,6 +1,6 @@
 //! lodeval's integration tests, compiled as one binary (ripgrep's habit). One module per area:
 //!
-//! - `cli`: the command line end to end (exit codes, output shapes, subcommands not built yet).
+//! - `cli`: the command line end to end (exit codes, output shapes, usage errors).
 //! - `bad_input`: crafted broken files across the formats; each must exit 2 with a message naming
 //!   the file and the problem, and never panic.
 //! - `models`: `lodeval info` on every model of the shared collection against MANIFEST.md's counts
@@ -8,6 +8,8 @@
 //! - `eval`: the batch evaluator (determinism, shards, gate, golden images, bad configs, LOD
 //!   chains on every shipped model).
 //! - `fuzz`: property-based mutation fuzzing of the OBJ, PLY, OFF and GLB paths.
+//! - `optimize`: `lodeval optimize` (Lindstrom–Turk): energy goes down, the vertex count stays,
+//!   the output is identical for 1, 2 and 8 threads; bad input exits 2.
 //! - `oracles`: metrics against reference implementations (FLIP: NVIDIA's; SSIM/PSNR: scikit-image).
 //! - `raster`: the CPU rasterizer (determinism over thread counts, watertightness, golden images,
 //!   the `render` CLI).
@@ -21,6 +23,7 @@ mod common;
 mod eval;
 mod fuzz;
 mod models;
+mod optimize;
 mod oracles;
 mod raster;
 mod simplify;
