@@ -340,12 +340,17 @@ struct MergeArgs {
 #[derive(Args, Debug)]
 struct OptimizeArgs {
     /// The original mesh (the target of the renderings).
-    original: PathBuf,
+    #[arg(required_unless_present = "experiment")]
+    original: Option<PathBuf>,
     /// The simplified mesh to improve (any simplifier's output).
-    simplified: PathBuf,
+    #[arg(required_unless_present = "experiment")]
+    simplified: Option<PathBuf>,
     /// Output OBJ.
-    #[arg(short, long)]
-    out: PathBuf,
+    #[arg(short, long, required_unless_present = "experiment")]
+    out: Option<PathBuf>,
+    /// Run the paper's experiment from a config (configs/papers/lindstrom-turk.toml) instead.
+    #[arg(long, conflicts_with_all = ["original", "simplified", "out"])]
+    experiment: Option<PathBuf>,
     /// Budget in energy evaluations.
     #[arg(long, default_value_t = 20_000)]
     evals: u64,
@@ -614,13 +619,29 @@ fn run(cli: Cli) -> Result<(), Error> {
         }
         Command::Optimize(a) => {
             use lodeval::simplify::lindstrom_turk::{Normals, Options};
+            if let Some(config) = &a.experiment {
+                let quiet = cli.quiet;
+                let rows =
+                    lodeval::simplify::lindstrom_turk::experiment::run(config, &mut |line| {
+                        if !quiet {
+                            eprintln!("{line}");
+                        }
+                    })?;
+                println!("{} runs; results.csv and plots written", rows.len());
+                return Ok(());
+            }
+            let (Some(original), Some(simplified), Some(out)) =
+                (a.original.clone(), a.simplified.clone(), a.out.clone())
+            else {
+                return Err(Error::Usage(
+                    "give ORIGINAL SIMPLIFIED -o OUT, or --experiment CONFIG".into(),
+                ));
+            };
             let normals = match a.normals.as_str() {
                 "derived" => Normals::Derived,
                 "free" => Normals::Free,
                 n => {
-                    return Err(Error::Usage(format!(
-                        "--normals {n}: use derived or free"
-                    )));
+                    return Err(Error::Usage(format!("--normals {n}: use derived or free")));
                 }
             };
             if a.views == 0 || a.size < 8 || a.size > 4096 {
@@ -636,9 +657,9 @@ fn run(cli: Cli) -> Result<(), Error> {
             options.normals = normals;
             options.attributes = !a.no_attributes;
             let job = lodeval::commands::OptimizeJob {
-                original: a.original,
-                simplified: a.simplified,
-                out: a.out.clone(),
+                original,
+                simplified,
+                out: out.clone(),
                 energy_csv: a.energy_csv,
                 options,
                 progress: !cli.quiet && std::io::IsTerminal::is_terminal(&std::io::stderr()),
@@ -646,7 +667,7 @@ fn run(cli: Cli) -> Result<(), Error> {
             let o = lodeval::commands::optimize(&job)?;
             println!(
                 "{}  {} vertices  d_MS {:.6e} -> {:.6e} ({:.1} % of the input's energy)  {} evaluations in {:.1} s ({:.0}/s)  accepted: {} no-op, {} swap, {} teleport",
-                a.out.display(),
+                out.display(),
                 o.vertices.1,
                 o.initial_d_ms,
                 o.final_d_ms,

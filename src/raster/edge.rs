@@ -28,6 +28,10 @@ pub(crate) struct TileSamples {
     pub ids: Vec<u32>,
     /// Coverage counts per sample (diagnostic mode only: every covering triangle counts, no depth test).
     pub counts: Option<Vec<u16>>,
+    /// Break depth ties by the lower id instead of by drawing order. With ids that increase in
+    /// drawing order this gives the same result in any order (the incremental luminance images
+    /// rasterize a region's triangles in whatever order they find them).
+    pub lowest_id_wins_ties: bool,
 }
 
 /// Marker for an uncovered sample.
@@ -42,6 +46,7 @@ impl TileSamples {
             depth: vec![f32::INFINITY; n],
             ids: vec![EMPTY; n],
             counts: count_coverage.then(|| vec![0; n]),
+            lowest_id_wins_ties: false,
         }
     }
 }
@@ -159,7 +164,8 @@ fn scan<const S: usize>(
                     (e2 - bias[2]) as f64,
                 );
                 let depth = ((w0 * z[0] + w1 * z[1] + w2 * z[2]) * inv_area) as f32;
-                if depth < buf.depth[slot] {
+                let d = buf.depth[slot];
+                if depth < d || (buf.lowest_id_wins_ties && depth == d && id < buf.ids[slot]) {
                     buf.depth[slot] = depth;
                     buf.ids[slot] = id;
                 }

@@ -41,6 +41,12 @@ use crate::scene::{Camera, Scene};
 /// Tile edge of the triangle buckets, pixels.
 pub const BUCKET: u32 = 16;
 
+/// Bits of a pixel id for the piece of its triangle (clipping makes at most 7 pieces).
+const PIECE_BITS: u32 = 3;
+const PIECE_MASK: u32 = (1 << PIECE_BITS) - 1;
+/// Stamp bit of a triangle whose shading, not coverage, changed.
+const RESHADE: u32 = 1 << 31;
+
 /// Largest luminance code.
 pub const LUMA_MAX: u16 = u16::MAX;
 
@@ -87,8 +93,10 @@ struct View {
     tiles_x: u32,
     target: Vec<u16>,
     current: Vec<u16>,
-    /// Source triangle shown at each pixel (`u32::MAX`: background).
+    /// Piece shown at each pixel, as `triangle << PIECE_BITS | piece` ([`EMPTY`]: background).
     shown: Vec<u32>,
+    /// Depth at each pixel (infinite on the background).
+    depth: Vec<f32>,
     trial: Trial,
 }
 
@@ -102,10 +110,14 @@ struct Trial {
     rect: Option<[i32; 4]>,
     pixels: Vec<u16>,
     shown: Vec<u32>,
-    /// Per source triangle: the trial number that changed it.
+    /// Per source triangle: the trial number that changed it (with [`RESHADE`] set when only its
+    /// shading changed).
     stamp: Vec<u32>,
+    /// Per changed source triangle: index of its first new piece in `pieces`.
+    first_piece: Vec<u32>,
+    /// Per source triangle: the trial number that already rasterized it.
+    visited: Vec<u32>,
     number: u32,
-    candidates: Vec<(u32, u32, bool)>,
     samples: Option<TileSamples>,
     setup: SetupOut,
 }
@@ -119,8 +131,11 @@ pub struct Change<'a> {
     pub vertices: &'a [u32],
     /// Wedges with changed (or new) attributes.
     pub wedges: &'a [u32],
-    /// Changed, born or dead triangles: must include every triangle using a listed vertex or wedge.
+    /// Changed, born or dead triangles: must include every triangle using a listed vertex.
     pub triangles: &'a [u32],
+    /// Triangles whose corners did not move but use a listed wedge (only their shading changes).
+    /// Together with `triangles` they must include every triangle using a listed wedge.
+    pub reshaded: &'a [u32],
 }
 
 /// The luminance images of an editable mesh in a set of views, updated incrementally.
@@ -247,12 +262,10 @@ impl LumaViews {
                     bbox: Vec::new(),
                     buckets: vec![Vec::new(); n_tiles],
                     tiles_x,
-                    target: targets
-                        .as_mut()
-                        .and_then(|t| t.next())
-                        .unwrap_or_default(),
+                    target: targets.as_mut().and_then(|t| t.next()).unwrap_or_default(),
                     current: vec![shared.background; n],
-                    shown: vec![u32::MAX; n],
+                    shown: vec![EMPTY; n],
+                    depth: vec![f32::INFINITY; n],
                     trial: Trial::default(),
                 }
             })
@@ -265,6 +278,7 @@ impl LumaViews {
             vertices: &all_v,
             wedges: &all_w,
             triangles: &all_t,
+            reshaded: &[],
         };
         let shared_ref = &shared;
         let wm = &wedge_material;
@@ -387,7 +401,12 @@ fn sq(t: u16, y: u16) -> i64 {
 fn union(a: Option<[i32; 4]>, b: [i32; 4]) -> [i32; 4] {
     match a {
         None => b,
-        Some(a) => [a[0].min(b[0]), a[1].min(b[1]), a[2].max(b[2]), a[3].max(b[3])],
+        Some(a) => [
+            a[0].min(b[0]),
+            a[1].min(b[1]),
+            a[2].max(b[2]),
+            a[3].max(b[3]),
+        ],
     }
 }
 
@@ -400,7 +419,6 @@ fn tiles(tiles_x: u32, r: [i32; 4]) -> impl Iterator<Item = usize> {
 }
 
 impl View {
-
     fn trial(
         &mut self,
         shared: &Shared,
@@ -410,7 +428,13 @@ impl View {
         everything: bool,
     ) -> i64 {
         let tr = &mut self.trial;
-        tr.number = tr.number.wrapping_add(1).max(1);
+        tr.number = (tr.number + 1) & !RESHADE;
+        if tr.number == 0 {
+            // Wrapped: forget every old stamp.
+            tr.stamp.iter_mut().for_each(|s| *s = 0);
+            tr.visited.iter_mut().for_each(|s| *s = 0);
+            tr.number = 1;
+        }
         tr.saved_xf.clear();
         tr.saved_light.clear();
         tr.pieces.clear();
@@ -419,7 +443,10 @@ impl View {
         // New vertex transforms and wedge light terms (old values saved for a revert).
         let grow = |len: &mut usize, need: usize| *len = (*len).max(need);
         let mut nv = self.xf.len();
-        change.vertices.iter().for_each(|&v| grow(&mut nv, v as usize + 1));
+        change
+            .vertices
+            .iter()
+            .for_each(|&v| grow(&mut nv, v as usize + 1));
         if nv > self.xf.len() {
             let fill = transform_one(Vec3::ZERO, self.mvp, &self.planes, self.vp);
             self.xf.resize(nv, fill);
@@ -432,8 +459,12 @@ impl View {
             }
         }
         let mut nw = self.light.len();
-        change.wedges.iter().for_each(|&w| grow(&mut nw, w as usize + 1));
-        self.light.resize(nw.max(self.light.len()), (Vec3::ZERO, Vec3::ZERO));
+        change
+            .wedges
+            .iter()
+            .for_each(|&w| grow(&mut nw, w as usize + 1));
+        self.light
+            .resize(nw.max(self.light.len()), (Vec3::ZERO, Vec3::ZERO));
         for &w in change.wedges {
             if (w as usize) < mesh.wedges.len() {
                 tr.saved_light.push((w, self.light[w as usize]));
@@ -452,10 +483,14 @@ impl View {
         let slots = mesh.triangle_slots().max(self.pieces.len());
         if tr.stamp.len() < slots {
             tr.stamp.resize(slots, 0);
+            tr.first_piece.resize(slots, 0);
+            tr.visited.resize(slots, 0);
         }
+        let number = tr.number;
         let mut rect: Option<[i32; 4]> = None;
         for &t in change.triangles {
-            tr.stamp[t as usize] = tr.number;
+            tr.stamp[t as usize] = number;
+            tr.first_piece[t as usize] = tr.pieces.len() as u32;
             if let Some(Some(b)) = self.bbox.get(t as usize) {
                 rect = Some(union(rect, *b));
             }
@@ -482,6 +517,16 @@ impl View {
             }
             tr.bbox.push((t, bb));
         }
+        // Triangles that only need shading anew (their wedges changed, not their corners).
+        let reshade = number | RESHADE;
+        for &t in change.reshaded {
+            if tr.stamp[t as usize] != number {
+                tr.stamp[t as usize] = reshade;
+                if let Some(Some(b)) = self.bbox.get(t as usize) {
+                    rect = Some(union(rect, *b));
+                }
+            }
+        }
         let Some(rect) = rect else {
             return 0;
         };
@@ -491,59 +536,70 @@ impl View {
             rect
         };
         tr.rect = Some(rect);
-        // Candidates: committed triangles overlapping the rectangle (through the buckets), except
-        // changed ones, plus the new pieces; in the order a full render draws them.
-        let overlaps =
-            |b: [i32; 4]| b[0] < rect[2] && rect[0] < b[2] && b[1] < rect[3] && rect[1] < b[3];
-        tr.candidates.clear();
-        for tile in tiles(self.tiles_x, rect) {
-            for &t in &self.buckets[tile] {
-                if tr.stamp[t as usize] == tr.number {
-                    continue;
-                }
-                for (k, p) in self.pieces[t as usize].iter().enumerate() {
-                    if overlaps(p.st.bbox) {
-                        tr.candidates.push((t, k as u32, false));
-                    }
-                }
-            }
-        }
-        for (k, (t, p)) in tr.pieces.iter().enumerate() {
-            if overlaps(p.st.bbox) {
-                tr.candidates.push((*t, k as u32, true));
-            }
-        }
-        tr.candidates.sort_unstable();
-        tr.candidates.dedup();
-        // Rasterize the rectangle (one sample at each pixel centre).
+        // Start from the committed depth and winners; where a changed triangle won, a hole opens
+        // that only the unchanged triangles below it can fill.
         let samples = tr
             .samples
             .get_or_insert_with(|| TileSamples::new([0, 0, 1, 1], 1, false));
         samples.reset(rect);
+        samples.lowest_id_wins_ties = true;
+        let [x0, y0, x1, y1] = rect;
+        let w = shared.width as usize;
+        let mut holes: Option<[i32; 4]> = None;
+        for y in y0..y1 {
+            let row = (y - y0) as usize * (x1 - x0) as usize;
+            for x in x0..x1 {
+                let i = y as usize * w + x as usize;
+                let shown = self.shown[i];
+                if shown != EMPTY && tr.stamp[(shown >> PIECE_BITS) as usize] == number {
+                    holes = Some(union(holes, [x, y, x + 1, y + 1]));
+                } else {
+                    let k = row + (x - x0) as usize;
+                    samples.depth[k] = self.depth[i];
+                    samples.ids[k] = shown;
+                }
+            }
+        }
         let offsets = [[fixed::ONE_PIXEL / 2, fixed::ONE_PIXEL / 2]];
         let mut scratch = [[0i64; 3]; 1];
-        let piece = |c: &(u32, u32, bool)| -> &Piece {
-            if c.2 {
-                &tr.pieces[c.1 as usize].1
-            } else {
-                &self.pieces[c.0 as usize][c.1 as usize]
+        if let Some(h) = holes {
+            // The unchanged triangles overlapping the holes (through the buckets), each once.
+            let overlaps = |b: [i32; 4]| b[0] < h[2] && h[0] < b[2] && b[1] < h[3] && h[1] < b[3];
+            for tile in tiles(self.tiles_x, h) {
+                for &t in &self.buckets[tile] {
+                    let tu = t as usize;
+                    if tr.stamp[tu] == number || tr.visited[tu] == number {
+                        continue;
+                    }
+                    tr.visited[tu] = number;
+                    for (k, p) in self.pieces[tu].iter().enumerate() {
+                        if overlaps(p.st.bbox) {
+                            let id = (t << PIECE_BITS) | k as u32;
+                            edge::rasterize(&p.st, id, &offsets, h, samples, &mut scratch);
+                        }
+                    }
+                }
             }
-        };
-        for (id, c) in tr.candidates.iter().enumerate() {
+        }
+        // The changed triangles' new pieces.
+        let mut k = 0;
+        while k < tr.pieces.len() {
+            let t = tr.pieces[k].0;
+            let first = tr.first_piece[t as usize] as usize;
+            let id = (t << PIECE_BITS) | (k - first) as u32;
             edge::rasterize(
-                &piece(c).st,
-                id as u32,
+                &tr.pieces[k].1.st,
+                id,
                 &offsets,
                 rect,
                 samples,
                 &mut scratch,
             );
+            k += 1;
         }
-        // Shade and compare. A pixel that still shows the same unchanged triangle keeps its
-        // value (that triangle's corners and attributes are as committed); only pixels showing a
-        // changed triangle, or a different one than before, are shaded.
-        let [x0, y0, x1, y1] = rect;
-        let w = shared.width as usize;
+        // Shade and compare. A pixel that still shows the same piece of an unchanged triangle
+        // keeps its value (its corners and attributes are as committed); only pixels showing a
+        // changed or re-shaded triangle, or another piece than before, are shaded.
         tr.pixels.clear();
         tr.shown.clear();
         let mut delta = 0i64;
@@ -552,23 +608,29 @@ impl View {
                 let k = ((y - y0) * (x1 - x0) + (x - x0)) as usize;
                 let i = y as usize * w + x as usize;
                 let id = samples.ids[k];
-                let (luma, tri) = if id == EMPTY {
-                    (shared.background, u32::MAX)
+                let luma = if id == EMPTY {
+                    shared.background
                 } else {
-                    let c = &tr.candidates[id as usize];
-                    if !c.2 && self.shown[i] == c.0 && !everything {
-                        (self.current[i], c.0)
+                    let t = id >> PIECE_BITS;
+                    let stamp = tr.stamp[t as usize];
+                    if id == self.shown[i] && stamp != number && stamp != reshade {
+                        self.current[i]
                     } else {
-                        let p = piece(c);
+                        let piece = (id & PIECE_MASK) as usize;
+                        let p = if stamp == number {
+                            &tr.pieces[tr.first_piece[t as usize] as usize + piece].1
+                        } else {
+                            &self.pieces[t as usize][piece]
+                        };
                         let x = x as f64 + 0.5;
-                        (shade(shared, mesh, &self.light, c.0, p, x, y as f64 + 0.5), c.0)
+                        shade(shared, mesh, &self.light, t, p, x, y as f64 + 0.5)
                     }
                 };
                 if !self.target.is_empty() {
                     delta += sq(self.target[i], luma) - sq(self.target[i], self.current[i]);
                 }
                 tr.pixels.push(luma);
-                tr.shown.push(tri);
+                tr.shown.push(id);
             }
         }
         delta
@@ -608,16 +670,19 @@ impl View {
             }
         }
         let tr = &mut self.trial;
-        if let Some([x0, y0, x1, y1]) = tr.rect {
+        if let (Some([x0, y0, x1, y1]), Some(samples)) = (tr.rect, &tr.samples) {
             let (w, rw) = (shared.width as usize, (x1 - x0) as usize);
             for (row, y) in (y0..y1).enumerate() {
                 let dst = y as usize * w + x0 as usize;
-                self.current[dst..dst + rw].copy_from_slice(&tr.pixels[row * rw..(row + 1) * rw]);
-                self.shown[dst..dst + rw].copy_from_slice(&tr.shown[row * rw..(row + 1) * rw]);
+                let src = row * rw..(row + 1) * rw;
+                self.current[dst..dst + rw].copy_from_slice(&tr.pixels[src.clone()]);
+                self.shown[dst..dst + rw].copy_from_slice(&tr.shown[src.clone()]);
+                self.depth[dst..dst + rw].copy_from_slice(&samples.depth[src]);
             }
         }
         tr.saved_xf.clear();
         tr.saved_light.clear();
+        tr.rect = None;
     }
 
     fn revert(&mut self) {
@@ -728,8 +793,7 @@ mod tests {
             .images();
         let coarse = Arc::new(shapes::icosphere(1));
         let mut adj = Adjacency::new(&coarse);
-        let mut views =
-            LumaViews::new(&adj, &scene, &cams, 64, 64, Some(targets.clone())).unwrap();
+        let mut views = LumaViews::new(&adj, &scene, &cams, 64, 64, Some(targets.clone())).unwrap();
         let e0 = views.energy();
         assert!(e0 > 0);
         let v = 5u32;
@@ -739,6 +803,7 @@ mod tests {
             vertices: &[v],
             wedges: &[],
             triangles: &tris,
+            reshaded: &[],
         };
         let delta = views.trial(&adj, &change);
         views.commit();

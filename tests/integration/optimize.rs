@@ -3,7 +3,11 @@
 use crate::common::{lodeval, model};
 
 /// Simplify the 3k-triangle bunny with vertex clustering, then optimize it with a small budget.
-fn run(dir: &std::path::Path, threads: &str, out: &str) -> (crate::common::Run, std::path::PathBuf) {
+fn run(
+    dir: &std::path::Path,
+    threads: &str,
+    out: &str,
+) -> (crate::common::Run, std::path::PathBuf) {
     let original = model("bunny/bunny_odedstein_3k.obj");
     let coarse = dir.join("coarse.obj");
     if !coarse.exists() {
@@ -62,8 +66,19 @@ fn lowers_the_energy_keeps_the_vertex_count_and_is_thread_independent() {
     let log = std::fs::read_to_string(out1.with_extension("csv")).unwrap();
     let rows: Vec<&str> = log.lines().collect();
     assert_eq!(rows[0], "evals,seconds,d_ms,relative");
-    assert!(rows[1].ends_with(",1.0") || rows[1].ends_with(",1"), "{}", rows[1]);
-    let last: f64 = rows.last().unwrap().rsplit(',').next().unwrap().parse().unwrap();
+    assert!(
+        rows[1].ends_with(",1.0") || rows[1].ends_with(",1"),
+        "{}",
+        rows[1]
+    );
+    let last: f64 = rows
+        .last()
+        .unwrap()
+        .rsplit(',')
+        .next()
+        .unwrap()
+        .parse()
+        .unwrap();
     assert!(last < 1.0);
     // Vertex count: same as the input's.
     let count = |p: &std::path::Path| {
@@ -78,7 +93,12 @@ fn lowers_the_energy_keeps_the_vertex_count_and_is_thread_independent() {
         assert_eq!(r.code, 0, "{}", r.stderr);
         // (The OBJ names its .mtl, so the outputs share a file name in separate folders.)
         let same = std::fs::read(&out).unwrap() == std::fs::read(&out1).unwrap();
-        assert!(same, "{t} threads: {} differs from {}", out.display(), out1.display());
+        assert!(
+            same,
+            "{t} threads: {} differs from {}",
+            out.display(),
+            out1.display()
+        );
     }
 }
 

@@ -53,6 +53,7 @@ pub(super) struct Affected {
     wedges: Vec<u32>,
     normal_wedges: Vec<u32>,
     tris: Vec<u32>,
+    reshaded: Vec<u32>,
 }
 
 /// The optimizer's state.
@@ -196,10 +197,21 @@ impl State {
 
     /// What moving `moved` after a connectivity operation around `topo` (whose triangles
     /// `op_tris` changed, and which made `new_wedges`) touches.
-    pub fn affected(&self, moved: &[u32], topo: &[u32], op_tris: &[u32], new_wedges: &[u32]) -> Affected {
+    pub fn affected(
+        &self,
+        moved: &[u32],
+        topo: &[u32],
+        op_tris: &[u32],
+        new_wedges: &[u32],
+    ) -> Affected {
         let base: Vec<u32> = sorted(moved.iter().chain(topo).copied().collect());
         let shaded = match self.normals {
-            Normals::Derived => sorted(self.ring(moved).into_iter().chain(topo.iter().copied()).collect()),
+            Normals::Derived => sorted(
+                self.ring(moved)
+                    .into_iter()
+                    .chain(topo.iter().copied())
+                    .collect(),
+            ),
             Normals::Free => base.clone(),
         };
         let normal_wedges = match self.normals {
@@ -213,18 +225,26 @@ impl State {
                 .chain(new_wedges.iter().copied())
                 .collect(),
         );
-        let tris = sorted(
-            shaded
-                .iter()
+        let incident = |vs: &[u32]| -> Vec<u32> {
+            vs.iter()
                 .flat_map(|&v| self.adj.vertex_triangles(v).iter().copied())
-                .chain(op_tris.iter().copied())
-                .collect(),
-        );
+                .collect()
+        };
+        // Triangles with a moved corner (or changed connectivity) change coverage; the others
+        // around re-derived normals only change shading.
+        let mut tris = incident(&base);
+        tris.extend_from_slice(op_tris);
+        let tris = sorted(tris);
+        let reshaded: Vec<u32> = sorted(incident(&shaded))
+            .into_iter()
+            .filter(|t| tris.binary_search(t).is_err())
+            .collect();
         Affected {
             verts: base,
             wedges,
             normal_wedges,
             tris,
+            reshaded,
         }
     }
 
@@ -258,7 +278,8 @@ impl State {
                     let o = (k + j) % 3;
                     len += (self.adj.positions[tri[o] as usize] - self.adj.positions[v as usize])
                         .length() as f64;
-                    uv_len += (self.adj.wedges[c[o] as usize].uv - self.adj.wedges[c[k] as usize].uv)
+                    uv_len += (self.adj.wedges[c[o] as usize].uv
+                        - self.adj.wedges[c[k] as usize].uv)
                         .length() as f64;
                     n += 1;
                 }
@@ -315,6 +336,7 @@ impl State {
                 vertices: &aff.verts,
                 wedges: &aff.wedges,
                 triangles: &aff.tris,
+                reshaded: &aff.reshaded,
             },
         )
     }
@@ -332,14 +354,26 @@ impl State {
         new_wedges: &[u32],
         known_zero: bool,
     ) -> i64 {
-        let set: Vec<u32> = set.iter().copied().filter(|&v| !self.adj.is_locked(v)).collect();
+        let set: Vec<u32> = set
+            .iter()
+            .copied()
+            .filter(|&v| !self.adj.is_locked(v))
+            .collect();
         let aff = self.affected(&set, topo, op_tris, new_wedges);
-        let slots = if optimize { self.layout(&set) } else { Vec::new() };
+        let slots = if optimize {
+            self.layout(&set)
+        } else {
+            Vec::new()
+        };
         if slots.is_empty() {
             return if known_zero { 0 } else { self.eval(&aff) };
         }
         let (p0, steps) = self.values(&slots, &set);
-        let f0 = if known_zero { 0.0 } else { self.eval(&aff) as f64 };
+        let f0 = if known_zero {
+            0.0
+        } else {
+            self.eval(&aff) as f64
+        };
         let limit = (32 * p0.len()).min(self.remaining().max(1) as usize);
         let best = simplex::minimize(&p0, f0, &steps, limit, |p| {
             self.apply(&slots, p);

@@ -19,6 +19,7 @@
 //! and every random choice comes from a seeded PCG, so a run is reproducible for any thread count.
 
 mod edit;
+pub mod experiment;
 mod moves;
 pub mod oracle;
 pub mod simplex;
@@ -147,7 +148,12 @@ pub fn target_images(original: &Arc<Mesh>, cameras: &[Camera], size: u32) -> Res
 }
 
 /// d_MS (eq. 1) of `mesh` against target images from `cameras`.
-pub fn d_ms(mesh: &Arc<Mesh>, cameras: &[Camera], size: u32, targets: Vec<Vec<u16>>) -> Result<f64> {
+pub fn d_ms(
+    mesh: &Arc<Mesh>,
+    cameras: &[Camera],
+    size: u32,
+    targets: Vec<Vec<u16>>,
+) -> Result<f64> {
     let scene = Scene::new(mesh.clone());
     let adj = Adjacency::new(mesh);
     let views = LumaViews::new(&adj, &scene, cameras, size, size, Some(targets))?;
@@ -226,7 +232,14 @@ pub fn optimize(
     let scene = Scene::new(simplified.clone());
     let adj = Adjacency::new(simplified);
     let adj = edit::prepare(adj, opts.normals);
-    let views = LumaViews::new(&adj, &scene, &cams, opts.size, opts.size, Some(targets))?;
+    let views = LumaViews::new(
+        &adj,
+        &scene,
+        &cams,
+        opts.size,
+        opts.size,
+        Some(targets.clone()),
+    )?;
     let st = State::new(adj, views, opts);
     let live = |adj: &Adjacency| {
         (0..adj.positions.len() as u32)
@@ -324,7 +337,26 @@ pub fn optimize(
     if log.last().is_none_or(|r| r.evals != opt.st.evals) {
         log.push(row(&opt));
     }
-    debug_assert_eq!(opt.st.energy, opt.st.views.energy());
+    // Self-check: the energy tracked through every accepted ΔE, the incrementally updated images
+    // and a full render of the final mesh agree exactly (integer energies).
+    let fresh = LumaViews::new(
+        &opt.st.adj,
+        &scene,
+        &cams,
+        opts.size,
+        opts.size,
+        Some(targets),
+    )?;
+    if opt.st.energy != opt.st.views.energy()
+        || fresh.energy() != opt.st.energy
+        || fresh.images() != opt.st.views.images()
+    {
+        return Err(Error::Internal(format!(
+            "image-driven optimizer: incremental energy {} / images disagree with a full render (energy {})",
+            opt.st.energy,
+            fresh.energy()
+        )));
+    }
     let vertices_out = live(&opt.st.adj);
     let mesh = opt.st.adj.to_mesh(simplified)?;
     Ok(Outcome {

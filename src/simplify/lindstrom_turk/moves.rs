@@ -276,7 +276,7 @@ impl Optimizer {
             }
             self.st.reject(Some(undo));
             if cheapest.is_none_or(|c| delta < c.2) {
-                cheapest = Some((e, level as i8, delta));
+                cheapest = Some((e, level, delta));
             }
             if level < COLLAPSE_MAX_LEVEL {
                 self.queue.set(e, delta, level);
@@ -325,7 +325,8 @@ impl Optimizer {
         (a, b): (u32, u32),
         level: u8,
     ) -> Option<(i64, crate::mesh::adjacency::Undo, Vec<u32>)> {
-        let mid: Vec3 = 0.5 * (self.st.adj.positions[a as usize] + self.st.adj.positions[b as usize]);
+        let mid: Vec3 =
+            0.5 * (self.st.adj.positions[a as usize] + self.st.adj.positions[b as usize]);
         let before = self.incident(&[a, b]);
         self.st.begin();
         let (undo, keep) = match self.st.adj.collapse(a, b, mid) {

@@ -80,7 +80,10 @@ pub fn minimize(
         centroid.iter_mut().for_each(|c| *c = 0.0);
         for (k, p) in pts.iter().enumerate() {
             if k != hi {
-                centroid.iter_mut().zip(p).for_each(|(c, x)| *c += x / n as f64);
+                centroid
+                    .iter_mut()
+                    .zip(p)
+                    .for_each(|(c, x)| *c += x / n as f64);
             }
         }
         // Reflect.

@@ -138,15 +138,6 @@ impl Stats {
         let bound = b.mean() * s.time() / b.time() + std::f64::consts::SQRT_2 * z * s.sigma();
         s.mean() <= bound.min(total)
     }
-
-    /// (operation, mean ΔE, σ, mean evaluations, weight) for every operation with a history.
-    pub fn table(&self) -> Vec<((Move, u8), f64, f64, f64, f64)> {
-        self.ops
-            .iter()
-            .filter(|(_, s)| s.weight > 0.0)
-            .map(|(k, s)| (*k, s.mean(), s.sigma(), s.time(), s.weight))
-            .collect()
-    }
 }
 
 #[cfg(test)]

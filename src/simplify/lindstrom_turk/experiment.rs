@@ -1,0 +1,332 @@
+//! The paper's experiment (§6, Figures 5–6) as a config: each model is simplified by vertex
+//! clustering, by our QEM and by meshoptimizer to several vertex counts, each result is optimized,
+//! and the energy is measured on held-out views (24 by default, a Fibonacci sphere: none of them is
+//! one of the 20 dodecahedron views used while optimizing), before and after, relative to each
+//! input. Writes `results.csv`, one energy log per run (`energy/MODEL-METHOD-V.csv`), the meshes
+//! (`meshes/`), and two SVG plots: held-out energy against vertex count, and energy against
+//! evaluations.
+
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+use serde::{Deserialize, Serialize};
+
+use super::{Options, cameras, d_ms, optimize, target_images};
+use crate::error::{Error, Result};
+use crate::mesh::{self, LoadOptions, Mesh};
+use crate::scene::Rig;
+use crate::simplify::{Goal, Method, chain};
+
+/// One model of the experiment.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ModelSpec {
+    /// Short name for files and tables.
+    pub name: String,
+    /// Mesh path, relative to the config file.
+    pub path: PathBuf,
+    /// Target vertex counts of the simplified inputs.
+    pub vertices: Vec<usize>,
+}
+
+/// The experiment config.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Experiment {
+    /// Output folder, relative to the config file.
+    pub out: PathBuf,
+    /// Evaluation budget per run.
+    pub evals: u64,
+    /// Views while optimizing.
+    #[serde(default = "default_views")]
+    pub views: u32,
+    /// Image size.
+    #[serde(default = "default_size")]
+    pub size: u32,
+    /// Held-out views for the final energies.
+    #[serde(default = "default_held_out")]
+    pub held_out_views: u32,
+    /// Seed.
+    #[serde(default = "default_seed")]
+    pub seed: u64,
+    /// Simplifiers making the inputs.
+    pub methods: Vec<Method>,
+    /// Models.
+    pub model: Vec<ModelSpec>,
+}
+
+fn default_views() -> u32 {
+    20
+}
+fn default_size() -> u32 {
+    256
+}
+fn default_held_out() -> u32 {
+    24
+}
+fn default_seed() -> u64 {
+    1
+}
+
+/// One row of `results.csv`.
+#[derive(Debug, Clone, Serialize)]
+pub struct ResultRow {
+    /// Model name.
+    pub model: String,
+    /// Simplifier of the input.
+    pub method: String,
+    /// Vertices of the input (and the output).
+    pub vertices: usize,
+    /// Triangles of the input.
+    pub triangles_in: usize,
+    /// Triangles of the output.
+    pub triangles_out: usize,
+    /// Held-out d_MS of the input.
+    pub held_out_before: f64,
+    /// Held-out d_MS of the optimized mesh.
+    pub held_out_after: f64,
+    /// after / before.
+    pub held_out_relative: f64,
+    /// d_MS over the optimization views, before and after.
+    pub train_before: f64,
+    /// See `train_before`.
+    pub train_after: f64,
+    /// Energy evaluations.
+    pub evals: u64,
+    /// Seconds (wall clock; reporting only).
+    pub seconds: f64,
+    /// Accepted no-ops, swaps, teleports.
+    pub accepted_no_op: u64,
+    /// See `accepted_no_op`.
+    pub accepted_swap: u64,
+    /// See `accepted_no_op`.
+    pub accepted_teleport: u64,
+}
+
+/// Run the experiment in `config`; `log` receives one line per finished run.
+pub fn run(config: &Path, log: &mut dyn FnMut(&str)) -> Result<Vec<ResultRow>> {
+    let text = String::from_utf8(crate::mesh::read_file(config)?)
+        .map_err(|_| Error::input(config, "the config is not UTF-8 text", "save it as UTF-8"))?;
+    let exp: Experiment = toml::from_str(&text).map_err(|e| {
+        Error::input(
+            config,
+            e.message().trim().to_string(),
+            "fix the key or value (see configs/papers/lindstrom-turk.toml for the schema)",
+        )
+    })?;
+    let base = config.parent().unwrap_or(Path::new("."));
+    let out = base.join(&exp.out);
+    for d in ["energy", "meshes"] {
+        std::fs::create_dir_all(out.join(d))
+            .map_err(|e| Error::Internal(format!("cannot create {}: {e}", out.display())))?;
+    }
+    let mut rows = Vec::new();
+    let mut curves: Vec<(String, Vec<(f64, f64)>)> = Vec::new();
+    for spec in &exp.model {
+        let path = base.join(&spec.path);
+        let original: Arc<Mesh> = Arc::new(mesh::load(&path, &LoadOptions::default())?);
+        let held_cams = cameras(&original, &Rig::Fibonacci(exp.held_out_views));
+        let held_targets = target_images(&original, &held_cams, exp.size)?;
+        for &method in &exp.methods {
+            for &v in &spec.vertices {
+                let lods = chain(&original, method, &[Goal::Triangles(2 * v)])?;
+                let input = Arc::new(
+                    lods.into_iter()
+                        .next()
+                        .map(|l| l.mesh)
+                        .ok_or_else(|| Error::Internal("the simplifier returned no LOD".into()))?,
+                );
+                let opts = Options {
+                    evals: exp.evals,
+                    views: exp.views,
+                    size: exp.size,
+                    seed: exp.seed,
+                    ..Options::default()
+                };
+                let before = d_ms(&input, &held_cams, exp.size, held_targets.clone())?;
+                let o = optimize(&original, &input, &opts, &|_| {})?;
+                let result = Arc::new(o.mesh.clone());
+                let after = d_ms(&result, &held_cams, exp.size, held_targets.clone())?;
+                let stem = format!("{}-{}-{}", spec.name, method.name(), v);
+                crate::mesh::write_obj::write(
+                    &input,
+                    &out.join("meshes").join(format!("{stem}-input.obj")),
+                )?;
+                crate::mesh::write_obj::write(
+                    &result,
+                    &out.join("meshes").join(format!("{stem}-optimized.obj")),
+                )?;
+                crate::commands::write_energy_csv(
+                    &out.join("energy").join(format!("{stem}.csv")),
+                    &o.log,
+                )?;
+                curves.push((
+                    stem.clone(),
+                    o.log.iter().map(|r| (r.evals as f64, r.relative)).collect(),
+                ));
+                let row = ResultRow {
+                    model: spec.name.clone(),
+                    method: method.name().into(),
+                    vertices: o.vertices.1,
+                    triangles_in: input.triangle_count(),
+                    triangles_out: result.triangle_count(),
+                    held_out_before: before,
+                    held_out_after: after,
+                    held_out_relative: after / before.max(f64::MIN_POSITIVE),
+                    train_before: o.initial_d_ms,
+                    train_after: o.final_d_ms,
+                    evals: o.evals,
+                    seconds: o.seconds,
+                    accepted_no_op: o.accepted.no_op,
+                    accepted_swap: o.accepted.swap,
+                    accepted_teleport: o.accepted.teleport,
+                };
+                log(&format!(
+                    "{stem}: {} vertices, held-out d_MS {:.4e} -> {:.4e} ({:.1} %), {} evals in {:.1} s",
+                    row.vertices,
+                    before,
+                    after,
+                    100.0 * row.held_out_relative,
+                    o.evals,
+                    o.seconds
+                ));
+                rows.push(row);
+            }
+        }
+    }
+    let mut w = csv::Writer::from_writer(Vec::new());
+    for r in &rows {
+        w.serialize(r)
+            .map_err(|e| Error::Internal(format!("results CSV: {e}")))?;
+    }
+    let bytes = w
+        .into_inner()
+        .map_err(|e| Error::Internal(format!("results CSV: {e}")))?;
+    crate::io::write_atomic(&out.join("results.csv"), &bytes)?;
+    for spec in &exp.model {
+        let mut series = Vec::new();
+        for m in &exp.methods {
+            let pts = |f: fn(&ResultRow) -> f64| -> Vec<(f64, f64)> {
+                rows.iter()
+                    .filter(|r| r.model == spec.name && r.method == m.name())
+                    .map(|r| (r.vertices as f64, f(r)))
+                    .collect()
+            };
+            series.push((
+                format!("{} input", m.name()),
+                pts(|r| r.held_out_before),
+                true,
+            ));
+            series.push((
+                format!("{} optimized", m.name()),
+                pts(|r| r.held_out_after),
+                false,
+            ));
+        }
+        let svg = plot(
+            &format!("{}: held-out d_MS against vertex count", spec.name),
+            "vertices",
+            "held-out d_MS",
+            &series,
+        );
+        crate::io::write_atomic(
+            &out.join(format!("{}-energy-vs-vertices.svg", spec.name)),
+            svg.as_bytes(),
+        )?;
+    }
+    let series: Vec<Series> = curves.into_iter().map(|(n, p)| (n, p, false)).collect();
+    let svg = plot(
+        "energy (relative to the input) against evaluations",
+        "energy evaluations",
+        "E / E(input)",
+        &series,
+    );
+    crate::io::write_atomic(&out.join("energy-vs-evals.svg"), svg.as_bytes())?;
+    Ok(rows)
+}
+
+/// A plotted series: name, points, dashed.
+type Series = (String, Vec<(f64, f64)>, bool);
+
+const COLORS: [&str; 8] = [
+    "#1b9e77", "#d95f02", "#7570b3", "#e7298a", "#66a61e", "#e6ab02", "#a6761d", "#666666",
+];
+
+/// A line plot: series of (name, points, dashed), linear axes from zero.
+fn plot(title: &str, x_label: &str, y_label: &str, series: &[Series]) -> String {
+    let (w, h, ml, mr, mt, mb) = (720.0, 420.0, 80.0, 220.0, 40.0, 50.0);
+    let all = series.iter().flat_map(|s| s.1.iter());
+    let x_max = all.clone().map(|p| p.0).fold(0.0f64, f64::max).max(1e-12) * 1.05;
+    let y_max = all.map(|p| p.1).fold(0.0f64, f64::max).max(1e-12) * 1.1;
+    let px = |x: f64| ml + x / x_max * (w - ml - mr);
+    let py = |y: f64| h - mb - y / y_max * (h - mt - mb);
+    let mut s = String::new();
+    let _ = writeln!(
+        s,
+        "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"{w}\" height=\"{h}\" font-family=\"sans-serif\" font-size=\"12\"><rect width=\"{w}\" height=\"{h}\" fill=\"#fff\"/><text x=\"{ml}\" y=\"24\" font-size=\"15\">{title}</text><rect x=\"{ml}\" y=\"{mt}\" width=\"{}\" height=\"{}\" fill=\"none\" stroke=\"#888\"/>",
+        w - ml - mr,
+        h - mt - mb
+    );
+    for k in 0..=4 {
+        let (x, y) = (x_max * k as f64 / 4.0, y_max * k as f64 / 4.0);
+        let _ = writeln!(
+            s,
+            "<text x=\"{:.1}\" y=\"{:.1}\" text-anchor=\"middle\">{}</text><text x=\"{:.1}\" y=\"{:.1}\" text-anchor=\"end\">{:.3e}</text><line x1=\"{ml}\" x2=\"{:.1}\" y1=\"{:.1}\" y2=\"{:.1}\" stroke=\"#eee\"/>",
+            px(x),
+            h - mb + 16.0,
+            x.round(),
+            ml - 4.0,
+            py(y) + 4.0,
+            y,
+            w - mr,
+            py(y),
+            py(y)
+        );
+    }
+    for (k, (name, pts, dashed)) in series.iter().enumerate() {
+        let color = COLORS[(k / if series.iter().any(|s| s.2) { 2 } else { 1 }) % COLORS.len()];
+        let dash = if *dashed {
+            " stroke-dasharray=\"6 4\""
+        } else {
+            ""
+        };
+        let mut pts = pts.clone();
+        pts.sort_by(|a, b| a.0.total_cmp(&b.0));
+        let line: Vec<String> = pts
+            .iter()
+            .map(|p| format!("{:.1},{:.1}", px(p.0), py(p.1)))
+            .collect();
+        let _ = writeln!(
+            s,
+            "<polyline points=\"{}\" fill=\"none\" stroke=\"{color}\" stroke-width=\"2\"{dash}/>",
+            line.join(" ")
+        );
+        for p in &pts {
+            let _ = writeln!(
+                s,
+                "<circle cx=\"{:.1}\" cy=\"{:.1}\" r=\"2.5\" fill=\"{color}\"/>",
+                px(p.0),
+                py(p.1)
+            );
+        }
+        let ly = mt + 16.0 * k as f64 + 8.0;
+        let _ = writeln!(
+            s,
+            "<line x1=\"{0:.1}\" x2=\"{1:.1}\" y1=\"{ly:.1}\" y2=\"{ly:.1}\" stroke=\"{color}\" stroke-width=\"2\"{dash}/><text x=\"{2:.1}\" y=\"{3:.1}\">{name}</text>",
+            w - mr + 10.0,
+            w - mr + 34.0,
+            w - mr + 40.0,
+            ly + 4.0
+        );
+    }
+    let _ = writeln!(
+        s,
+        "<text x=\"{:.1}\" y=\"{:.1}\" text-anchor=\"middle\">{x_label}</text><text x=\"16\" y=\"{:.1}\" transform=\"rotate(-90 16 {:.1})\" text-anchor=\"middle\">{y_label}</text></svg>",
+        (ml + w - mr) / 2.0,
+        h - 10.0,
+        h / 2.0,
+        h / 2.0
+    );
+    s
+}
