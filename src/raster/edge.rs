@@ -52,6 +52,16 @@ impl TileSamples {
 }
 
 impl TileSamples {
+    /// Size the buffers for `rect` (no coverage counting) without clearing them: for a caller
+    /// that writes every sample before rasterizing.
+    pub fn resize_for(&mut self, rect: [i32; 4]) {
+        let n = ((rect[2] - rect[0]) * (rect[3] - rect[1])) as usize * self.samples;
+        self.rect = rect;
+        self.depth.resize(n, f32::INFINITY);
+        self.ids.resize(n, EMPTY);
+        self.counts = None;
+    }
+
     /// Reuse the buffers for `rect` (no coverage counting), cleared.
     pub fn reset(&mut self, rect: [i32; 4]) {
         let n = ((rect[2] - rect[0]) * (rect[3] - rect[1])) as usize * self.samples;

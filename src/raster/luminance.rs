@@ -389,7 +389,8 @@ impl LumaViews {
         if !std::mem::take(&mut self.pending) {
             return;
         }
-        self.views.par_iter_mut().for_each(|v| v.revert());
+        // Restoring a few saved values per view: cheaper than waking the thread pool.
+        self.views.iter_mut().for_each(|v| v.revert());
     }
 }
 
@@ -541,7 +542,7 @@ impl View {
         let samples = tr
             .samples
             .get_or_insert_with(|| TileSamples::new([0, 0, 1, 1], 1, false));
-        samples.reset(rect);
+        samples.resize_for(rect);
         samples.lowest_id_wins_ties = true;
         let [x0, y0, x1, y1] = rect;
         let w = shared.width as usize;
@@ -551,10 +552,12 @@ impl View {
             for x in x0..x1 {
                 let i = y as usize * w + x as usize;
                 let shown = self.shown[i];
+                let k = row + (x - x0) as usize;
                 if shown != EMPTY && tr.stamp[(shown >> PIECE_BITS) as usize] == number {
                     holes = Some(union(holes, [x, y, x + 1, y + 1]));
+                    samples.depth[k] = f32::INFINITY;
+                    samples.ids[k] = EMPTY;
                 } else {
-                    let k = row + (x - x0) as usize;
                     samples.depth[k] = self.depth[i];
                     samples.ids[k] = shown;
                 }
@@ -600,8 +603,9 @@ impl View {
         // Shade and compare. A pixel that still shows the same piece of an unchanged triangle
         // keeps its value (its corners and attributes are as committed); only pixels showing a
         // changed or re-shaded triangle, or another piece than before, are shaded.
-        tr.pixels.clear();
-        tr.shown.clear();
+        let n_rect = ((x1 - x0) * (y1 - y0)) as usize;
+        tr.pixels.resize(n_rect, 0);
+        tr.shown.resize(n_rect, 0);
         let mut delta = 0i64;
         for y in y0..y1 {
             for x in x0..x1 {
@@ -629,8 +633,8 @@ impl View {
                 if !self.target.is_empty() {
                     delta += sq(self.target[i], luma) - sq(self.target[i], self.current[i]);
                 }
-                tr.pixels.push(luma);
-                tr.shown.push(id);
+                tr.pixels[k] = luma;
+                tr.shown[k] = id;
             }
         }
         delta
