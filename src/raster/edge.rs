@@ -61,17 +61,6 @@ impl TileSamples {
         self.ids.resize(n, EMPTY);
         self.counts = None;
     }
-
-    /// Reuse the buffers for `rect` (no coverage counting), cleared.
-    pub fn reset(&mut self, rect: [i32; 4]) {
-        let n = ((rect[2] - rect[0]) * (rect[3] - rect[1])) as usize * self.samples;
-        self.rect = rect;
-        self.depth.clear();
-        self.depth.resize(n, f32::INFINITY);
-        self.ids.clear();
-        self.ids.resize(n, EMPTY);
-        self.counts = None;
-    }
 }
 
 /// Rasterize set-up triangle `st` (index `id`) into `buf`, restricted to `clip` (a sub-rectangle
