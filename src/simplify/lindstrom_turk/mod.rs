@@ -268,16 +268,26 @@ impl Optimizer {
 
     /// Optimize edge e: moves in order, levels by inequality 3; stop after the first move kind
     /// that made progress. Returns the energy change.
+    ///
+    /// Decision: when inequality 3 rejects every applicable operation on an edge (it happens once
+    /// the most efficient operation is one the edge does not allow, e.g. a swap across an
+    /// attribute boundary), the cheapest geometry move (no-op level 1) is attempted anyway, so the
+    /// statistics keep being refreshed instead of the optimizer stalling.
     fn optimize_edge(&mut self, e: (u32, u32)) -> i64 {
         let mut total = 0i64;
+        let start_evals = self.st.evals;
         for mv in Move::ALL {
             for level in mv.levels() {
                 if self.st.remaining() == 0 {
                     return total;
                 }
-                if !self.stats.should_attempt((mv, level), total as f64) {
+                let last = mv == Move::Teleport && level == 3;
+                let forced = last && self.st.evals == start_evals;
+                let op = if forced { (Move::NoOp, 1) } else { (mv, level) };
+                if !forced && !self.stats.should_attempt(op, total as f64) {
                     continue;
                 }
+                let (mv, level) = op;
                 let start = self.st.evals;
                 let Some(delta) = self.run(e, mv, level) else {
                     break; // not applicable to this edge (any more)
