@@ -732,13 +732,18 @@ pub fn write_energy_csv(
     path: &Path,
     log: &[crate::simplify::lindstrom_turk::EnergyRow],
 ) -> Result<()> {
+    write_rows_csv(path, log)
+}
+
+/// Write serializable rows as CSV (header from the field names), atomically.
+pub fn write_rows_csv<T: serde::Serialize>(path: &Path, rows: &[T]) -> Result<()> {
     let mut w = csv::Writer::from_writer(Vec::new());
-    for row in log {
+    for row in rows {
         w.serialize(row)
-            .map_err(|e| Error::Internal(format!("energy CSV: {e}")))?;
+            .map_err(|e| Error::Internal(format!("{}: {e}", path.display())))?;
     }
     let bytes = w
         .into_inner()
-        .map_err(|e| Error::Internal(format!("energy CSV: {e}")))?;
+        .map_err(|e| Error::Internal(format!("{}: {e}", path.display())))?;
     crate::io::write_atomic(path, &bytes)
 }

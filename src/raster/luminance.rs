@@ -248,14 +248,7 @@ impl LumaViews {
                         cull_backfaces: false,
                         sample_span: [half, half, half, half],
                     },
-                    lights: scene
-                        .lights
-                        .iter()
-                        .map(|l| {
-                            let (dir, color) = l.resolve(camera);
-                            ResolvedLight::new(dir, color, camera.to_eye())
-                        })
-                        .collect(),
+                    lights: ResolvedLight::for_camera(&scene.lights, camera),
                     xf: Vec::new(),
                     light: Vec::new(),
                     pieces: Vec::new(),

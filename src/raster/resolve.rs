@@ -82,14 +82,7 @@ impl Pass {
             binned,
             offsets,
             count_coverage,
-            lights: scene
-                .lights
-                .iter()
-                .map(|l| {
-                    let (dir, color) = l.resolve(camera);
-                    ResolvedLight::new(dir, color, camera.to_eye())
-                })
-                .collect(),
+            lights: ResolvedLight::for_camera(&scene.lights, camera),
             depth_range,
         }
     }

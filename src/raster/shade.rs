@@ -81,6 +81,17 @@ pub(crate) struct ResolvedLight {
 }
 
 impl ResolvedLight {
+    /// The scene's lights resolved for `camera`.
+    pub fn for_camera(lights: &[crate::scene::Light], camera: &crate::scene::Camera) -> Vec<Self> {
+        lights
+            .iter()
+            .map(|l| {
+                let (dir, color) = l.resolve(camera);
+                ResolvedLight::new(dir, color, camera.to_eye())
+            })
+            .collect()
+    }
+
     pub fn new(l: Vec3, color: Vec3, to_eye: Vec3) -> ResolvedLight {
         ResolvedLight {
             l,

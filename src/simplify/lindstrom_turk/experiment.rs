@@ -194,15 +194,7 @@ pub fn run(config: &Path, log: &mut dyn FnMut(&str)) -> Result<Vec<ResultRow>> {
             }
         }
     }
-    let mut w = csv::Writer::from_writer(Vec::new());
-    for r in &rows {
-        w.serialize(r)
-            .map_err(|e| Error::Internal(format!("results CSV: {e}")))?;
-    }
-    let bytes = w
-        .into_inner()
-        .map_err(|e| Error::Internal(format!("results CSV: {e}")))?;
-    crate::io::write_atomic(&out.join("results.csv"), &bytes)?;
+    crate::commands::write_rows_csv(&out.join("results.csv"), &rows)?;
     for spec in &exp.model {
         let mut series = Vec::new();
         for m in &exp.methods {
