@@ -33,7 +33,7 @@ use super::edge::{self, EMPTY, TileSamples};
 use super::setup::{SetupOut, SetupTri, Viewport, XfVertex, setup_one, transform_one};
 use super::shade::{ResolvedLight, light_terms, source_barycentrics};
 use super::texture::MipTexture;
-use super::{camera_setup, fixed};
+use super::{camera_setup, fixed, rect_union as union};
 use crate::error::{Error, Result};
 use crate::mesh::adjacency::Adjacency;
 use crate::scene::{Camera, Scene};
@@ -390,18 +390,6 @@ impl LumaViews {
 fn sq(t: u16, y: u16) -> i64 {
     let d = t as i64 - y as i64;
     d * d
-}
-
-fn union(a: Option<[i32; 4]>, b: [i32; 4]) -> [i32; 4] {
-    match a {
-        None => b,
-        Some(a) => [
-            a[0].min(b[0]),
-            a[1].min(b[1]),
-            a[2].max(b[2]),
-            a[3].max(b[3]),
-        ],
-    }
 }
 
 /// Bucket tiles (row-major, `tiles_x` per row) overlapped by a pixel rectangle.

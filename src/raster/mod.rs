@@ -219,6 +219,19 @@ pub fn coverage_counts(
     Ok(pass.counts())
 }
 
+/// The smallest pixel rectangle `[x0, y0, x1, y1)` holding `a` (if any) and `b`.
+pub(crate) fn rect_union(a: Option<[i32; 4]>, b: [i32; 4]) -> [i32; 4] {
+    match a {
+        None => b,
+        Some(a) => [
+            a[0].min(b[0]),
+            a[1].min(b[1]),
+            a[2].max(b[2]),
+            a[3].max(b[3]),
+        ],
+    }
+}
+
 /// Camera matrices and depth range for a frame of the given size.
 fn camera_setup(camera: &Camera, width: u32, height: u32) -> (glam::Mat4, (f32, f32, bool)) {
     let aspect = width as f32 / height as f32;

@@ -22,7 +22,7 @@ use super::edge::{self, TileSamples};
 use super::frame::Frame;
 use super::resolve::{Pass, blit};
 use super::setup::{setup_one, transform_one};
-use super::{RenderSettings, Shading, shade};
+use super::{RenderSettings, Shading, rect_union, shade};
 use crate::error::{Error, Result};
 use crate::scene::{Camera, Scene};
 
@@ -79,17 +79,7 @@ impl RegionRenderer {
             )));
         }
         let mut dirty: Option<[i32; 4]> = None;
-        let mut grow = |b: [i32; 4]| {
-            dirty = Some(match dirty {
-                None => b,
-                Some(d) => [
-                    d[0].min(b[0]),
-                    d[1].min(b[1]),
-                    d[2].max(b[2]),
-                    d[3].max(b[3]),
-                ],
-            });
-        };
+        let mut grow = |b: [i32; 4]| dirty = Some(rect_union(dirty, b));
         // Old footprint of the changed triangles.
         for &t in changed {
             for id in self.pass.binned.ids_of(t) {
