@@ -12,7 +12,7 @@ use std::sync::Arc;
 
 use serde::{Deserialize, Serialize};
 
-use super::{Options, cameras, d_ms, held_out_rig, optimize, target_images};
+use super::{Options, Targets, cameras, d_ms, held_out_rig, optimize_towards, target_images};
 use crate::error::{Error, Result};
 use crate::mesh::{self, LoadOptions, Mesh};
 use crate::simplify::{Goal, Method, chain};
@@ -93,7 +93,8 @@ pub struct ResultRow {
     pub train_after: f64,
     /// Energy evaluations.
     pub evals: u64,
-    /// Seconds (wall clock; reporting only).
+    /// Seconds of the optimization (wall clock; reporting only; the targets, rendered once per
+    /// model, are not included).
     pub seconds: f64,
     /// Accepted no-ops, swaps, teleports.
     pub accepted_no_op: u64,
@@ -120,6 +121,13 @@ pub fn run(config: &Path, log: &mut dyn FnMut(&str)) -> Result<Vec<ResultRow>> {
         std::fs::create_dir_all(out.join(d))
             .map_err(|e| Error::Internal(format!("cannot create {}: {e}", out.display())))?;
     }
+    let opts = Options {
+        evals: exp.evals,
+        views: exp.views,
+        size: exp.size,
+        seed: exp.seed,
+        ..Options::default()
+    };
     let mut rows = Vec::new();
     let mut curves: Vec<(String, Vec<(f64, f64)>)> = Vec::new();
     for spec in &exp.model {
@@ -127,6 +135,8 @@ pub fn run(config: &Path, log: &mut dyn FnMut(&str)) -> Result<Vec<ResultRow>> {
         let original: Arc<Mesh> = Arc::new(mesh::load(&path, &LoadOptions::default())?);
         let held_cams = cameras(&original, &held_out_rig(exp.held_out_views));
         let held_targets = target_images(&original, &held_cams, exp.size)?;
+        // The optimization views' targets, rendered once per model.
+        let targets = Targets::new(&original, &opts)?;
         for &method in &exp.methods {
             for &v in &spec.vertices {
                 let lods = chain(&original, method, &[Goal::Triangles(2 * v)])?;
@@ -136,15 +146,8 @@ pub fn run(config: &Path, log: &mut dyn FnMut(&str)) -> Result<Vec<ResultRow>> {
                         .map(|l| l.mesh)
                         .ok_or_else(|| Error::Internal("the simplifier returned no LOD".into()))?,
                 );
-                let opts = Options {
-                    evals: exp.evals,
-                    views: exp.views,
-                    size: exp.size,
-                    seed: exp.seed,
-                    ..Options::default()
-                };
                 let before = d_ms(&input, &held_cams, exp.size, held_targets.clone())?;
-                let o = optimize(&original, &input, &opts, &|_| {})?;
+                let o = optimize_towards(targets.clone(), &input, &opts, &|_| {})?;
                 let result = Arc::new(o.mesh.clone());
                 let after = d_ms(&result, &held_cams, exp.size, held_targets.clone())?;
                 let stem = format!("{}-{}-{}", spec.name, method.name(), v);

@@ -187,11 +187,30 @@ pub(crate) struct Optimizer {
     accepted: Accepted,
 }
 
+/// The optimization views of an original: their cameras and target images ŷ. Made once per
+/// original and reused for every input optimized towards it.
+#[derive(Debug, Clone)]
+pub struct Targets {
+    cameras: Vec<Camera>,
+    images: Vec<Vec<u16>>,
+}
+
+impl Targets {
+    /// Render `original` from the `opts.views` optimization views at `opts.size`.
+    pub fn new(original: &Arc<Mesh>, opts: &Options) -> Result<Targets> {
+        if opts.views == 0 {
+            return Err(Error::Usage("the optimizer needs at least one view".into()));
+        }
+        let cameras = cameras(original, &rig_for(opts.views));
+        let images = target_images(original, &cameras, opts.size)?;
+        Ok(Targets { cameras, images })
+    }
+}
+
 /// What the optimizer was built from, for the final self-check.
 #[derive(Debug)]
 pub(crate) struct Setup {
-    cameras: Vec<Camera>,
-    targets: Vec<Vec<u16>>,
+    targets: Targets,
     scene: Scene,
 }
 
@@ -203,23 +222,21 @@ fn live_vertices(adj: &Adjacency) -> usize {
 }
 
 impl Optimizer {
-    /// The optimizer for `simplified` against the images of `original`.
+    /// The optimizer for `simplified` against `targets` (made with the same `opts`).
     pub(crate) fn new(
-        original: &Arc<Mesh>,
+        targets: Targets,
         simplified: &Arc<Mesh>,
         opts: &Options,
     ) -> Result<(Optimizer, Setup)> {
-        let cameras = cameras(original, &rig_for(opts.views));
-        let targets = target_images(original, &cameras, opts.size)?;
         let scene = Scene::new(simplified.clone());
         let adj = edit::prepare(Adjacency::new(simplified), opts.normals);
         let views = LumaViews::new(
             &adj,
             &scene,
-            &cameras,
+            &targets.cameras,
             opts.size,
             opts.size,
-            Some(targets.clone()),
+            Some(targets.images.clone()),
         )?;
         let st = State::new(adj, views, opts);
         let edges = st.adj.edges();
@@ -232,14 +249,7 @@ impl Optimizer {
             rng: Pcg64::seed_from_u64(opts.seed),
             accepted: Accepted::default(),
         };
-        Ok((
-            opt,
-            Setup {
-                cameras,
-                targets,
-                scene,
-            },
-        ))
+        Ok((opt, Setup { targets, scene }))
     }
 
     /// Self-check: the energy tracked through every accepted ΔE, the incrementally updated
@@ -248,10 +258,10 @@ impl Optimizer {
         let fresh = LumaViews::new(
             &self.st.adj,
             &setup.scene,
-            &setup.cameras,
+            &setup.targets.cameras,
             opts.size,
             opts.size,
-            Some(setup.targets.clone()),
+            Some(setup.targets.images.clone()),
         )?;
         if self.st.energy != self.st.views.energy()
             || fresh.energy() != self.st.energy
@@ -319,17 +329,42 @@ impl Optimizer {
 }
 
 /// Optimize `simplified` towards `original`. `progress` is called with the evaluations spent.
+/// The reported seconds include rendering the targets.
 pub fn optimize(
     original: &Arc<Mesh>,
     simplified: &Arc<Mesh>,
     opts: &Options,
     progress: &dyn Fn(u64),
 ) -> Result<Outcome> {
-    if opts.views == 0 {
-        return Err(Error::Usage("the optimizer needs at least one view".into()));
-    }
     let start = Instant::now();
-    let (mut opt, setup) = Optimizer::new(original, simplified, opts)?;
+    run(
+        Targets::new(original, opts)?,
+        simplified,
+        opts,
+        progress,
+        start,
+    )
+}
+
+/// Optimize `simplified` towards `targets` (of the original, made with the same `opts`), for
+/// several inputs of one original. The reported seconds exclude rendering the targets.
+pub fn optimize_towards(
+    targets: Targets,
+    simplified: &Arc<Mesh>,
+    opts: &Options,
+    progress: &dyn Fn(u64),
+) -> Result<Outcome> {
+    run(targets, simplified, opts, progress, Instant::now())
+}
+
+fn run(
+    targets: Targets,
+    simplified: &Arc<Mesh>,
+    opts: &Options,
+    progress: &dyn Fn(u64),
+    start: Instant,
+) -> Result<Outcome> {
+    let (mut opt, setup) = Optimizer::new(targets, simplified, opts)?;
     let vertices_in = live_vertices(&opt.st.adj);
     let e0 = opt.st.energy;
     let d_ms = |o: &Optimizer| o.st.views.d_ms(o.st.energy);

@@ -357,7 +357,7 @@ impl Optimizer {
 mod tests {
     use std::sync::Arc;
 
-    use super::super::{Optimizer, Options, Setup};
+    use super::super::{Optimizer, Options, Setup, Targets};
     use super::*;
     use crate::mesh::Mesh;
     use crate::raster::luminance::LumaViews;
@@ -382,7 +382,8 @@ mod tests {
             evals: 1_000_000,
             ..Options::default()
         };
-        let (opt, setup) = Optimizer::new(&original, &coarse, &opts).unwrap();
+        let targets = Targets::new(&original, &opts).unwrap();
+        let (opt, setup) = Optimizer::new(targets, &coarse, &opts).unwrap();
         (opt, setup, opts)
     }
 
@@ -390,10 +391,10 @@ mod tests {
         LumaViews::new(
             &opt.st.adj,
             &setup.scene,
-            &setup.cameras,
+            &setup.targets.cameras,
             opts.size,
             opts.size,
-            Some(setup.targets.clone()),
+            Some(setup.targets.images.clone()),
         )
         .unwrap()
         .energy()
