@@ -627,6 +627,106 @@ pub fn simplify(job: &SimplifyJob) -> Result<Vec<SimplifyRow>> {
     Ok(rows)
 }
 
+/// Which views a Williams et al. LOD is made for.
+#[derive(Debug, Clone)]
+pub enum WilliamsViews {
+    /// View K of a rig (default framing).
+    One(Rig, usize),
+    /// One static LOD for every view of a rig.
+    All(Rig),
+    /// A camera at an eye position looking at a target (default: the model's centre), framed
+    /// with the default field of view.
+    Camera(glam::Vec3, Option<glam::Vec3>),
+}
+
+/// A `lodeval simplify --method williams` request.
+#[derive(Debug, Clone)]
+pub struct WilliamsJob {
+    /// Input mesh.
+    pub mesh: PathBuf,
+    /// Output `.obj`.
+    pub out: PathBuf,
+    /// Triangle budget.
+    pub budget: usize,
+    /// Views.
+    pub views: WilliamsViews,
+    /// Shading the LOD is for.
+    pub shading: crate::raster::Shading,
+    /// Error criterion.
+    pub criterion: crate::simplify::williams::Criterion,
+    /// Image size (pixels) the views are seen at.
+    pub size: u32,
+}
+
+/// Simplify with Williams et al. 2003 and write the LOD as OBJ.
+pub fn simplify_williams(job: &WilliamsJob) -> Result<Vec<SimplifyRow>> {
+    use crate::simplify::williams::{Cut, Options, StaticGoal, Williams};
+    if job.out.extension().and_then(|e| e.to_str()) != Some("obj") {
+        return Err(Error::Usage(format!(
+            "-o {}: lodeval writes LODs as .obj (with .mtl and textures beside it)",
+            job.out.display()
+        )));
+    }
+    let mesh = mesh::load(&job.mesh, &LoadOptions::default())?;
+    let start = std::time::Instant::now();
+    let w = Williams::build(&mesh)?;
+    let opts = Options {
+        shading: job.shading,
+        criterion: job.criterion,
+        size: (job.size, job.size),
+        ..Options::default()
+    };
+    let lod = match &job.views {
+        WilliamsViews::All(rig) => w.static_lod(
+            &rig_cameras(&mesh, rig, 1.0),
+            StaticGoal::Budget(job.budget),
+            &opts,
+        )?,
+        WilliamsViews::One(rig, k) => {
+            let cams = rig_cameras(&mesh, rig, 1.0);
+            let cam = cams.get(*k).ok_or_else(|| {
+                Error::Usage(format!("--view {k}: the rig has views 0..{}", cams.len()))
+            })?;
+            let mut cut = Cut::coarsest(&w.hierarchy);
+            w.adapt(&mut cut, cam, job.budget, &opts);
+            w.mesh(&cut)?
+        }
+        WilliamsViews::Camera(eye, target) => {
+            let sphere = mesh.bounding_sphere();
+            let target = target.unwrap_or(sphere.center);
+            if !(eye.is_finite() && target.is_finite()) || eye.distance(target) <= 0.0 {
+                return Err(Error::Usage(
+                    "--camera: the eye must be finite and apart from the target".into(),
+                ));
+            }
+            let mut cam = Camera::frame_sphere(
+                sphere,
+                *eye - target,
+                Camera::DEFAULT_FOV_Y_DEG,
+                1.0,
+                Camera::DEFAULT_MARGIN,
+            );
+            cam.eye = *eye;
+            cam.target = target;
+            let dist = eye.distance(sphere.center);
+            cam.near = (dist - sphere.radius).max(dist * 1e-3);
+            cam.far = dist + sphere.radius;
+            let mut cut = Cut::coarsest(&w.hierarchy);
+            w.adapt(&mut cut, &cam, job.budget, &opts);
+            w.mesh(&cut)?
+        }
+    };
+    let seconds = start.elapsed().as_secs_f64();
+    crate::mesh::write_obj::write(&lod, &job.out)?;
+    Ok(vec![SimplifyRow {
+        file: job.out.clone(),
+        triangles: lod.triangle_count(),
+        ratio: lod.triangle_count() as f64 / mesh.triangle_count() as f64,
+        simplifier_error: None,
+        seconds,
+    }])
+}
+
 /// One row of `lodeval bench simplify`.
 #[derive(Debug, Clone, serde::Serialize)]
 pub struct SimplifyBenchRow {

@@ -293,9 +293,35 @@ struct SimplifyArgs {
     /// Output .obj (with --chain: files STEM-rXX.obj beside it).
     #[arg(short, long)]
     out: PathBuf,
-    /// qem (our edge collapse, Garland–Heckbert quadrics), cluster (Rossignac–Borrel) or meshopt.
+    /// qem (our edge collapse, Garland–Heckbert quadrics), cluster (Rossignac–Borrel), meshopt, or
+    /// williams (Williams et al. 2003: perceptual, view-dependent, to a --budget).
     #[arg(long, default_value = "qem")]
     method: String,
+    /// williams: triangle budget.
+    #[arg(long, conflicts_with_all = ["ratio", "triangles", "error", "chain"])]
+    budget: Option<usize>,
+    /// williams: the camera, as EX,EY,EZ (looking at the model's centre, default field of view) or
+    /// EX,EY,EZ,TX,TY,TZ. Default: view 0 of the default rig at the default framing.
+    #[arg(long, value_delimiter = ',', num_args = 1, conflicts_with_all = ["view", "all_views"])]
+    camera: Vec<f32>,
+    /// williams: use view K of --rig.
+    #[arg(long, conflicts_with = "all_views")]
+    view: Option<usize>,
+    /// williams: one static LOD for every view of --rig (each node keyed by its worst view).
+    #[arg(long)]
+    all_views: bool,
+    /// williams: view rig for --view and --all-views.
+    #[arg(long, default_value = "dodecahedron")]
+    rig: String,
+    /// williams: the shading the LOD is for (gouraud, phong, normal-mapped, unlit).
+    #[arg(long, default_value = "gouraud")]
+    shading: String,
+    /// williams: perceptual, object-space, screen-space or silhouette-10.
+    #[arg(long, default_value = "perceptual")]
+    criterion: String,
+    /// williams: image size the views are rendered at (pixels).
+    #[arg(long, default_value_t = 512)]
+    size: u32,
     /// Target ratio of the input's triangles.
     #[arg(long, conflicts_with_all = ["triangles", "error", "chain"])]
     ratio: Option<f64>,
@@ -681,6 +707,21 @@ fn run(cli: Cli) -> Result<(), Error> {
             );
             Ok(())
         }
+        Command::Simplify(a) if a.method == "williams" => {
+            let rows = lodeval::commands::simplify_williams(&williams_job(&a)?)?;
+            if a.json {
+                return emit_json(&rows);
+            }
+            for r in &rows {
+                println!(
+                    "{}  {} triangles ({:.4} of the input)",
+                    r.file.display(),
+                    r.triangles,
+                    r.ratio
+                );
+            }
+            Ok(())
+        }
         Command::Simplify(a) => {
             use lodeval::simplify::{Goal, Method};
             let method = match a.method.as_str() {
@@ -689,7 +730,7 @@ fn run(cli: Cli) -> Result<(), Error> {
                 "meshopt" => Method::Meshopt,
                 m => {
                     return Err(Error::Usage(format!(
-                        "--method {m}: use qem, cluster or meshopt"
+                        "--method {m}: use qem, cluster, meshopt or williams"
                     )));
                 }
             };
@@ -845,4 +886,61 @@ fn main() -> ExitCode {
             ExitCode::from(e.exit_code())
         }
     }
+}
+
+/// The `simplify --method williams` request from its arguments.
+fn williams_job(a: &SimplifyArgs) -> Result<lodeval::commands::WilliamsJob, Error> {
+    use lodeval::commands::WilliamsViews;
+    use lodeval::simplify::williams::Criterion;
+    let shading = Shading::parse(&a.shading)
+        .ok_or_else(|| Error::Usage(format!("--shading {}: unknown shading model", a.shading)))?;
+    let criterion = Criterion::ALL
+        .into_iter()
+        .find(|c| c.name() == a.criterion)
+        .ok_or_else(|| {
+            Error::Usage(format!(
+                "--criterion {}: use perceptual, object-space, screen-space or silhouette-10",
+                a.criterion
+            ))
+        })?;
+    let rig = Rig::parse(&a.rig).ok_or_else(|| {
+        Error::Usage(format!(
+            "--rig {}: use dodecahedron, icosahedron or fibonacci:N",
+            a.rig
+        ))
+    })?;
+    let views = match (a.camera.len(), a.all_views) {
+        (0, true) => WilliamsViews::All(rig),
+        (0, false) => WilliamsViews::One(rig, a.view.unwrap_or(0)),
+        (3, _) => {
+            WilliamsViews::Camera(glam::Vec3::new(a.camera[0], a.camera[1], a.camera[2]), None)
+        }
+        (6, _) => WilliamsViews::Camera(
+            glam::Vec3::new(a.camera[0], a.camera[1], a.camera[2]),
+            Some(glam::Vec3::new(a.camera[3], a.camera[4], a.camera[5])),
+        ),
+        (n, _) => {
+            return Err(Error::Usage(format!(
+                "--camera takes 3 numbers (eye) or 6 (eye, target), not {n}"
+            )));
+        }
+    };
+    let budget = a
+        .budget
+        .ok_or_else(|| Error::Usage("--method williams needs --budget N (triangles)".into()))?;
+    if a.size == 0 || a.size > 16384 {
+        return Err(Error::Usage(format!(
+            "--size {}: use 1..16384 pixels",
+            a.size
+        )));
+    }
+    Ok(lodeval::commands::WilliamsJob {
+        mesh: a.mesh.clone(),
+        out: a.out.clone(),
+        budget,
+        views,
+        shading,
+        criterion,
+        size: a.size,
+    })
 }

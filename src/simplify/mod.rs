@@ -9,6 +9,7 @@ pub mod cluster;
 pub mod lindstrom_turk;
 pub mod meshopt;
 pub mod qem;
+pub mod williams;
 
 use crate::error::{Error, Result};
 use crate::mesh::Mesh;
@@ -60,7 +61,7 @@ pub struct Lod {
 /// every vertex a seam, and no seam-respecting simplifier could collapse anything): the welded
 /// mesh with smooth normals, and whether the original was flat-shaded (≥ 99 % of triangles have
 /// all three corner normals equal to the face normal).
-fn normal_only_seams(mesh: &Mesh) -> Option<(Mesh, bool)> {
+pub(crate) fn normal_only_seams(mesh: &Mesh) -> Option<(Mesh, bool)> {
     if mesh.uvs().is_some()
         || mesh.colors().is_some()
         || mesh.welded_vertex_count() == mesh.vertex_count()

@@ -1,0 +1,238 @@
+//! Per-node preprocessing of Williams et al. 2003 §4: for every MT node, the bounds of the patch of
+//! the *original* surface it affects — bounding sphere, silhouette normal cone (face normals of the
+//! original triangles and of the node's own triangles, §5.3), shading normal cone (vertex normals,
+//! widened by the normal map's tilt, §5.4), intrinsic luminance range of the texels covered (§5.2,
+//! through `texels.rs`) — and its texture deviation.
+//!
+//! Cumulative, not incremental (§5.2): a node's bounds merge the bounds of every triangle it
+//! removes, and a triangle made by an earlier node carries that node's bounds, so each node bounds
+//! all original triangles under it (conservatively: a superset of the patch).
+//!
+//! Texture deviation (§2.2; Cohen, Olano, Manocha 1998): the 3D distance between a point of the
+//! original surface and the point of the simplified surface with the same texture coordinate.
+//! Decision: measured at the original vertices. Each vertex is tracked on the current triangle
+//! holding it; when a node replaces a patch, its vertices are placed on the new triangle whose UV
+//! triangle contains their UV (the parametric correspondence) or, where none does (untextured
+//! meshes, points across a UV seam), on the closest new triangle (the geometric correspondence the
+//! paper falls back to). The node's deviation is the largest distance so found, and at least its
+//! prerequisites' (deviation never shrinks going coarser).
+
+use std::collections::HashMap;
+
+use glam::{Vec2, Vec3};
+
+use super::bounds::{Ball, Cone, Range};
+use super::hierarchy::{Hierarchy, NONE};
+use super::texels::{LuminancePyramid, normal_map_tilt};
+use crate::mesh::surface_distance::point_triangle_distance2;
+use crate::metric::color::luminance;
+
+/// What the run-time evaluation needs of one node.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct NodeData {
+    /// Bounds of the original triangles under the node and of its own triangles.
+    pub ball: Ball,
+    /// Face normals (silhouette test).
+    pub silhouette: Cone,
+    /// Shading normals (lighting contrast).
+    pub shading: Cone,
+    /// Intrinsic (unlit) luminance range, linear 0..1.
+    pub luminance: Range,
+    /// Texture deviation, model units.
+    pub deviation: f32,
+    /// The material of its first removed triangle (for the highlight's colour and exponent).
+    pub material: u32,
+}
+
+/// Per-material shading facts.
+#[derive(Debug, Clone)]
+pub struct MaterialFacts {
+    /// Luminance of the specular colour.
+    pub specular: f32,
+    /// Blinn–Phong exponent.
+    pub shininess: f32,
+    /// Largest tilt of the normal map, radians (0 without one).
+    pub tilt: f32,
+    pub(crate) pyramid: Option<LuminancePyramid>,
+    pub(crate) base: f32,
+}
+
+/// The preprocessed hierarchy data.
+#[derive(Debug, Clone)]
+pub struct Preprocessed {
+    /// One entry per node.
+    pub nodes: Vec<NodeData>,
+    /// One entry per material of the original.
+    pub materials: Vec<MaterialFacts>,
+    /// Whether any material has a base-colour texture.
+    pub textured: bool,
+}
+
+/// Bounds of one triangle on its own.
+fn triangle_data(h: &Hierarchy, materials: &[MaterialFacts], t: u32) -> NodeData {
+    let tri = &h.tris[t as usize];
+    let c = tri.corners.map(|k| h.corners[k as usize]);
+    let p = c.map(|k| k.position);
+    let m = &materials[tri.material as usize];
+    let face = (p[1] - p[0]).cross(p[2] - p[0]);
+    let shading = c
+        .iter()
+        .fold(Cone::EMPTY, |acc, k| acc.merge(Cone::of(k.normal)))
+        .widen(m.tilt);
+    let texture = match &m.pyramid {
+        Some(pyr) => pyr.triangle_range(c.map(|k| k.uv)),
+        None => Range::of(m.base),
+    };
+    let tint = c
+        .iter()
+        .fold(Range::EMPTY, |r, k| r.merge(Range::of(luminance(k.color))));
+    NodeData {
+        ball: Ball::of_points(&p),
+        silhouette: Cone::of(face),
+        shading,
+        luminance: Range {
+            lo: texture.lo * tint.lo,
+            hi: texture.hi * tint.hi,
+        },
+        deviation: 0.0,
+        material: tri.material,
+    }
+}
+
+fn merge(a: NodeData, b: &NodeData) -> NodeData {
+    NodeData {
+        ball: a.ball.merge(b.ball),
+        silhouette: a.silhouette.merge(b.silhouette),
+        shading: a.shading.merge(b.shading),
+        luminance: a.luminance.merge(b.luminance),
+        deviation: a.deviation.max(b.deviation),
+        material: a.material,
+    }
+}
+
+/// Where a point lands on a new patch: the point with the same UV on a triangle whose UV triangle
+/// holds `uv`, else the closest point; returns (triangle index in `patch`, distance).
+fn place(p: Vec3, uv: Option<Vec2>, patch: &[[(Vec3, Vec2); 3]]) -> (usize, f32) {
+    if let Some(uv) = uv {
+        for (i, t) in patch.iter().enumerate() {
+            let (a, b, c) = (t[0].1, t[1].1, t[2].1);
+            let den = (b - a).perp_dot(c - a);
+            if den.abs() <= f32::EPSILON * 1e-3 {
+                continue;
+            }
+            let l1 = (uv - a).perp_dot(c - a) / den;
+            let l2 = (b - a).perp_dot(uv - a) / den;
+            let l0 = 1.0 - l1 - l2;
+            const SLACK: f32 = -1e-4;
+            if l0 >= SLACK && l1 >= SLACK && l2 >= SLACK {
+                let q = t[0].0 * l0 + t[1].0 * l1 + t[2].0 * l2;
+                return (i, q.distance(p));
+            }
+        }
+    }
+    patch
+        .iter()
+        .enumerate()
+        .map(|(i, t)| (i, point_triangle_distance2(p, &t.map(|k| k.0)).sqrt()))
+        .min_by(|a, b| a.1.total_cmp(&b.1).then(a.0.cmp(&b.0)))
+        .unwrap_or((0, 0.0))
+}
+
+/// Preprocess every node of `h`.
+pub fn preprocess(h: &Hierarchy) -> Preprocessed {
+    let materials: Vec<MaterialFacts> = h
+        .original
+        .materials()
+        .iter()
+        .map(|m| MaterialFacts {
+            specular: luminance(m.specular),
+            shininess: m.shininess,
+            tilt: m.normal_texture.as_deref().map_or(0.0, normal_map_tilt),
+            pyramid: m
+                .base_color_texture
+                .as_deref()
+                .map(|t| LuminancePyramid::new(t, m.base_color)),
+            base: luminance(m.base_color),
+        })
+        .collect();
+    let textured = h.original.uvs().is_some() && materials.iter().any(|m| m.pyramid.is_some());
+
+    // The original vertices, each on one original triangle.
+    let mut points: Vec<(Vec3, Vec2)> = Vec::new();
+    let mut on_tri: Vec<Vec<u32>> = vec![Vec::new(); h.tris.len()];
+    let mut seen: HashMap<[u32; 3], ()> = HashMap::new();
+    for t in 0..h.original_triangles {
+        for k in h.tris[t].corners {
+            let c = h.corners[k as usize];
+            if seen
+                .insert(c.position.to_array().map(f32::to_bits), ())
+                .is_none()
+            {
+                on_tri[t].push(points.len() as u32);
+                points.push((c.position, c.uv));
+            }
+        }
+    }
+
+    let mut nodes: Vec<NodeData> = Vec::with_capacity(h.node_count());
+    for n in 0..h.node_count() as u32 {
+        let removed = h.removed(n);
+        let mut data: Option<NodeData> = None;
+        for &t in removed {
+            let tri = h.tris[t as usize];
+            let d = if tri.creator == NONE {
+                triangle_data(h, &materials, t)
+            } else {
+                nodes[tri.creator as usize]
+            };
+            data = Some(match data {
+                None => d,
+                Some(acc) => merge(acc, &d),
+            });
+        }
+        let mut data = data.expect("a collapse removes triangles");
+        data.material = h.tris[removed[0] as usize].material;
+        let created = h.created(n);
+        for &t in created {
+            let p = h.positions(t);
+            data.silhouette = data
+                .silhouette
+                .merge(Cone::of((p[1] - p[0]).cross(p[2] - p[0])));
+            data.ball = data.ball.merge(Ball::of_points(&p));
+            for k in h.tris[t as usize].corners {
+                data.shading = data.shading.merge(
+                    Cone::of(h.corners[k as usize].normal)
+                        .widen(materials[h.tris[t as usize].material as usize].tilt),
+                );
+            }
+        }
+        // Texture deviation: move the patch's points onto the new triangles.
+        let patch: Vec<[(Vec3, Vec2); 3]> = created
+            .iter()
+            .map(|&t| {
+                h.tris[t as usize].corners.map(|k| {
+                    let c = h.corners[k as usize];
+                    (c.position, c.uv)
+                })
+            })
+            .collect();
+        let mut deviation = data.deviation;
+        if !patch.is_empty() {
+            for &t in removed {
+                for q in std::mem::take(&mut on_tri[t as usize]) {
+                    let (p, uv) = points[q as usize];
+                    let (i, d) = place(p, textured.then_some(uv), &patch);
+                    deviation = deviation.max(d);
+                    on_tri[created[i] as usize].push(q);
+                }
+            }
+        }
+        data.deviation = deviation;
+        nodes.push(data);
+    }
+    Preprocessed {
+        nodes,
+        materials,
+        textured,
+    }
+}
