@@ -140,7 +140,7 @@ struct DiffArgs {
 
 #[derive(Args, Debug)]
 struct BenchArgs {
-    /// What to measure: `raster`, `metrics REF TEST`, or `simplify MESH...`.
+    /// What to measure: `raster`, `metrics REF TEST`, `simplify MESH...` or `williams MESH...`.
     what: String,
     /// For `metrics`: the reference and test images; for `simplify`: the meshes.
     images: Vec<PathBuf>,
@@ -289,10 +289,14 @@ struct GoldenArgs {
 #[derive(Args, Debug)]
 struct SimplifyArgs {
     /// The mesh to simplify.
-    mesh: PathBuf,
+    #[arg(required_unless_present = "experiment")]
+    mesh: Option<PathBuf>,
     /// Output .obj (with --chain: files STEM-rXX.obj beside it).
-    #[arg(short, long)]
-    out: PathBuf,
+    #[arg(short, long, required_unless_present = "experiment")]
+    out: Option<PathBuf>,
+    /// Run Williams et al. 2003's evaluation from a config (configs/papers/williams2003.toml).
+    #[arg(long, conflicts_with_all = ["mesh", "out"])]
+    experiment: Option<PathBuf>,
     /// qem (our edge collapse, Garland–Heckbert quadrics), cluster (Rossignac–Borrel), meshopt, or
     /// williams (Williams et al. 2003: perceptual, view-dependent, to a --budget).
     #[arg(long, default_value = "qem")]
@@ -554,6 +558,34 @@ fn run(cli: Cli) -> Result<(), Error> {
                 let rows = lodeval::commands::bench_metrics(reference, test, a.runs)?;
                 return emit_json(&rows);
             }
+            if a.what == "williams" {
+                let mut t = String::from(
+                    "| mesh | triangles | MT nodes | hierarchy s | preprocess s | budget | frames | adapt ms median | p95 | max | first frame ms | nodes changed per frame (median) |\n|---|---|---|---|---|---|---|---|---|---|---|---|\n",
+                );
+                for p in &a.images {
+                    let name = p
+                        .file_stem()
+                        .map_or_else(String::new, |s| s.to_string_lossy().into_owned());
+                    let mesh = lodeval::mesh::load(p, &LoadOptions::DEFAULT)?;
+                    for r in lodeval::commands::bench_williams(&mesh, &a.ratios, a.views)? {
+                        t.push_str(&format!(
+                            "| {name} | {} | {} | {:.2} | {:.2} | {} | {} | {:.2} | {:.2} | {:.2} | {:.2} | {} |\n",
+                            r.triangles,
+                            r.nodes,
+                            r.hierarchy_seconds,
+                            r.preprocess_seconds,
+                            r.budget,
+                            r.frames,
+                            r.median_ms,
+                            r.p95_ms,
+                            r.max_ms,
+                            r.first_ms,
+                            r.median_changes
+                        ));
+                    }
+                }
+                return emit(&t);
+            }
             if a.what == "simplify" {
                 let mut meshes = Vec::new();
                 for p in &a.images {
@@ -707,6 +739,16 @@ fn run(cli: Cli) -> Result<(), Error> {
             );
             Ok(())
         }
+        Command::Simplify(SimplifyArgs {
+            experiment: Some(config),
+            ..
+        }) => {
+            let rows = lodeval::simplify::williams::experiment::run(&config, &mut |line| {
+                eprintln!("{line}")
+            })?;
+            eprintln!("{} curves points written", rows.len());
+            Ok(())
+        }
         Command::Simplify(a) if a.method == "williams" => {
             let rows = lodeval::commands::simplify_williams(&williams_job(&a)?)?;
             if a.json {
@@ -758,8 +800,8 @@ fn run(cli: Cli) -> Result<(), Error> {
                 ));
             };
             let job = lodeval::commands::SimplifyJob {
-                mesh: a.mesh,
-                out: a.out,
+                mesh: a.mesh.expect("clap requires it"),
+                out: a.out.expect("clap requires it"),
                 method,
                 chain: !a.chain.is_empty(),
                 goals,
@@ -935,8 +977,8 @@ fn williams_job(a: &SimplifyArgs) -> Result<lodeval::commands::WilliamsJob, Erro
         )));
     }
     Ok(lodeval::commands::WilliamsJob {
-        mesh: a.mesh.clone(),
-        out: a.out.clone(),
+        mesh: a.mesh.clone().expect("clap requires it"),
+        out: a.out.clone().expect("clap requires it"),
         budget,
         views,
         shading,

@@ -24,6 +24,9 @@ pub enum Method {
     Cluster,
     /// meshoptimizer's `simplify`.
     Meshopt,
+    /// Williams et al. 2003 perceptual budget refinement: one static LOD for the 20 views of the
+    /// default rig (each node keyed by its worst view), Gouraud shading, default viewing.
+    Williams,
 }
 
 impl Method {
@@ -33,6 +36,7 @@ impl Method {
             Method::Qem => "qem",
             Method::Cluster => "cluster",
             Method::Meshopt => "meshopt",
+            Method::Williams => "williams",
         }
     }
 }
@@ -196,6 +200,26 @@ fn chain_of(mesh: &Mesh, method: Method, goals: &[Goal]) -> Result<Vec<Lod>> {
                         })
                     }
                     _ => Err(Error::Internal("qem goal".into())),
+                })
+                .collect()
+        }
+        Method::Williams => {
+            let w = williams::Williams::build(mesh)?;
+            let cameras = crate::commands::rig_cameras(mesh, &crate::scene::Rig::Dodecahedron, 1.0);
+            let opts = williams::Options::default();
+            goals
+                .iter()
+                .map(|&g| {
+                    let t = tris(g).ok_or_else(|| {
+                        Error::Usage(
+                            "williams takes triangle or ratio targets (a budget), not an error"
+                                .into(),
+                        )
+                    })?;
+                    Ok(Lod {
+                        mesh: w.static_lod(&cameras, williams::StaticGoal::Budget(t), &opts)?,
+                        error: None,
+                    })
                 })
                 .collect()
         }

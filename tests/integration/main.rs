@@ -16,6 +16,8 @@
 //! - `simplify`: `lodeval simplify` and `lodeval geometry`, and the eval generators `qem` and
 //!   `cluster`.
 //! - `vdp`: the visible-difference predictor against established psychophysics.
+//! - `williams`: `lodeval simplify --method williams` (Williams et al. 2003): budget, thread
+//!   independence, views, bad requests, and the paper experiment on a tiny config.
 
 mod bad_input;
 mod cli;
@@ -28,3 +30,4 @@ mod oracles;
 mod raster;
 mod simplify;
 mod vdp;
+mod williams;

@@ -5,9 +5,17 @@
 //! In the collapse form of the MT: a node is *applied* when its collapse is in the current mesh.
 //! *Raising* (refining) a node undoes its collapse; it needs every applied dependent undone first.
 //! *Lowering* (simplifying) re-applies it; it needs every prerequisite applied first. Both are
-//! forced recursively, as the paper describes. The raise queue R holds applied nodes none of whose
-//! dependents is applied (directly below the cut, largest error first); the lower queue L holds
-//! unapplied nodes all of whose prerequisites are applied (directly above, smallest error first).
+//! forced recursively, as the paper describes ("lifting a node may require lifting parent nodes
+//! that are below the cut"). The raise queue R holds the applied nodes directly below the cut — at
+//! least one triangle they created is in the mesh — largest error first; the lower queue L holds
+//! the unapplied nodes directly above it — at least one triangle they remove is in the mesh —
+//! smallest error first.
+//!
+//! Decision, measured: queues restricted to nodes whose raise (or lower) needs nothing else fail
+//! on MTs built from a sequence of edge collapses, whose dependency chains are long: at a budget
+//! of 2 % of the bunny, only 12 nodes could be raised directly, all back-facing (key 0), while
+//! silhouette nodes with large keys sat behind them; the refinement stalled at an LOD with nothing
+//! visible refined.
 //!
 //! Each frame: keys of both queues are recomputed for the new view; then, as in the paper's
 //! `simplifyBudget`, lower the smallest-error node while over budget and raise the largest-error
@@ -18,9 +26,18 @@ use std::collections::BinaryHeap;
 
 use super::hierarchy::{Hierarchy, NONE};
 
+/// A node's error: (primary, tie-break), compared lexicographically. The perceptual criterion
+/// clamps frequencies at the CSF peak, so every large silhouette node has the same distance; the
+/// second component (the unclamped distance) orders those by size.
+pub type Key = [f64; 2];
+
+fn key_cmp(a: &Key, b: &Key) -> Ordering {
+    a[0].total_cmp(&b[0]).then(a[1].total_cmp(&b[1]))
+}
+
 /// A heap entry ordered by key, then node id (so runs are deterministic).
 #[derive(Debug, Clone, Copy, PartialEq)]
-struct Entry(f64, u32);
+struct Entry(Key, u32);
 impl Eq for Entry {}
 impl PartialOrd for Entry {
     fn partial_cmp(&self, o: &Self) -> Option<Ordering> {
@@ -29,7 +46,7 @@ impl PartialOrd for Entry {
 }
 impl Ord for Entry {
     fn cmp(&self, o: &Self) -> Ordering {
-        self.0.total_cmp(&o.0).then(o.1.cmp(&self.1))
+        key_cmp(&self.0, &o.0).then(o.1.cmp(&self.1))
     }
 }
 
@@ -37,14 +54,17 @@ impl Ord for Entry {
 #[derive(Debug, Clone)]
 pub struct Cut {
     applied: Vec<bool>,
-    /// Per node: applied dependents.
-    applied_dependents: Vec<u32>,
-    /// Per node: unapplied prerequisites.
-    missing_prerequisites: Vec<u32>,
+    /// Per node: its created triangles that are in the mesh.
+    alive_created: Vec<u32>,
+    /// Per node: its removed triangles that are in the mesh.
+    alive_removed: Vec<u32>,
+    /// Per node: it creates no triangle (a last collapse that removes a surface's final triangles
+    /// is adjacent to the source, whatever the cut).
+    creates_nothing: Vec<bool>,
     triangles: usize,
     raise: BinaryHeap<Entry>,
     lower: BinaryHeap<std::cmp::Reverse<Entry>>,
-    keys: Vec<f64>,
+    keys: Vec<Key>,
     /// The view (frame) number a node's key was computed for.
     key_frame: Vec<u32>,
     frame: u32,
@@ -56,18 +76,24 @@ impl Cut {
     /// The coarsest cut (every collapse applied), as the paper starts from the source.
     pub fn coarsest(h: &Hierarchy) -> Cut {
         let n = h.node_count();
-        let applied_dependents = (0..n as u32)
-            .map(|i| h.dependents(i).len() as u32)
+        let alive_created = (0..n as u32)
+            .map(|i| {
+                h.created(i)
+                    .iter()
+                    .filter(|&&t| h.tris[t as usize].remover == NONE)
+                    .count() as u32
+            })
             .collect();
         let triangles = h.tris.iter().filter(|t| t.remover == NONE).count();
         Cut {
             applied: vec![true; n],
-            applied_dependents,
-            missing_prerequisites: vec![0; n],
+            alive_created,
+            alive_removed: vec![0; n],
+            creates_nothing: (0..n as u32).map(|i| h.created(i).is_empty()).collect(),
             triangles,
             raise: BinaryHeap::new(),
             lower: BinaryHeap::new(),
-            keys: vec![0.0; n],
+            keys: vec![[0.0; 2]; n],
             key_frame: vec![0; n],
             frame: 0,
             last_changes: 0,
@@ -91,16 +117,19 @@ impl Cut {
             && (tri.remover == NONE || !self.applied[tri.remover as usize])
     }
 
+    /// Directly below the cut.
     fn raisable(&self, n: u32) -> bool {
-        self.applied[n as usize] && self.applied_dependents[n as usize] == 0
+        self.applied[n as usize]
+            && (self.alive_created[n as usize] > 0 || self.creates_nothing[n as usize])
     }
 
+    /// Directly above the cut.
     fn lowerable(&self, n: u32) -> bool {
-        !self.applied[n as usize] && self.missing_prerequisites[n as usize] == 0
+        !self.applied[n as usize] && self.alive_removed[n as usize] > 0
     }
 
     /// Node `n`'s key for the current frame (computed once per frame).
-    fn key_of(&mut self, n: u32, key: &dyn Fn(u32) -> f64) -> f64 {
+    fn key_of(&mut self, n: u32, key: &dyn Fn(u32) -> Key) -> Key {
         if self.key_frame[n as usize] != self.frame {
             self.key_frame[n as usize] = self.frame;
             self.keys[n as usize] = key(n);
@@ -108,7 +137,7 @@ impl Cut {
         self.keys[n as usize]
     }
 
-    fn enqueue(&mut self, n: u32, key: &dyn Fn(u32) -> f64) {
+    fn enqueue(&mut self, n: u32, key: &dyn Fn(u32) -> Key) {
         if self.raisable(n) || self.lowerable(n) {
             self.key_of(n, key);
         }
@@ -121,32 +150,42 @@ impl Cut {
     }
 
     /// Flip node `n` (its own constraints must hold) and update the counters and queues.
-    fn flip(&mut self, h: &Hierarchy, n: u32, apply: bool, key: &dyn Fn(u32) -> f64) {
+    fn flip(&mut self, h: &Hierarchy, n: u32, apply: bool, key: &dyn Fn(u32) -> Key) {
         self.applied[n as usize] = apply;
         let delta = h.removed(n).len() as isize - h.created(n).len() as isize;
         self.triangles = (self.triangles as isize + if apply { -delta } else { delta }) as usize;
-        for &p in h.prerequisites(n) {
-            if apply {
-                self.applied_dependents[p as usize] += 1;
-            } else {
-                self.applied_dependents[p as usize] -= 1;
-                self.enqueue(p, key);
+        // n's removed triangles die (apply) or return; its created ones the reverse. Each one's
+        // creator and remover see their counts change.
+        let step = |c: &mut u32, up: bool| {
+            if up { *c += 1 } else { *c -= 1 }
+        };
+        let mut touched = vec![n];
+        for &t in h.removed(n) {
+            let creator = h.tris[t as usize].creator;
+            if creator != NONE {
+                step(&mut self.alive_created[creator as usize], !apply);
+                touched.push(creator);
             }
+            step(&mut self.alive_removed[n as usize], !apply);
         }
-        for &d in h.dependents(n) {
-            if apply {
-                self.missing_prerequisites[d as usize] -= 1;
-                self.enqueue(d, key);
-            } else {
-                self.missing_prerequisites[d as usize] += 1;
+        for &t in h.created(n) {
+            let remover = h.tris[t as usize].remover;
+            if remover != NONE {
+                step(&mut self.alive_removed[remover as usize], apply);
+                touched.push(remover);
             }
+            step(&mut self.alive_created[n as usize], apply);
         }
-        self.enqueue(n, key);
+        touched.sort_unstable();
+        touched.dedup();
+        for m in touched {
+            self.enqueue(m, key);
+        }
         self.last_changes += 1;
     }
 
     /// Undo node `n`'s collapse, first undoing every applied dependent (recursively).
-    pub fn raise(&mut self, h: &Hierarchy, n: u32, key: &dyn Fn(u32) -> f64) {
+    pub fn raise(&mut self, h: &Hierarchy, n: u32, key: &dyn Fn(u32) -> Key) {
         let mut stack = vec![n];
         while let Some(&m) = stack.last() {
             if !self.applied[m as usize] {
@@ -164,7 +203,7 @@ impl Cut {
     }
 
     /// Apply node `n`'s collapse, first applying every missing prerequisite (recursively).
-    pub fn lower(&mut self, h: &Hierarchy, n: u32, key: &dyn Fn(u32) -> f64) {
+    pub fn lower(&mut self, h: &Hierarchy, n: u32, key: &dyn Fn(u32) -> Key) {
         let mut stack = vec![n];
         while let Some(&m) = stack.last() {
             if self.applied[m as usize] {
@@ -205,7 +244,7 @@ impl Cut {
     }
 
     /// Re-key the queues with `key` (this view's errors) and refine to `budget` triangles.
-    pub fn adapt(&mut self, h: &Hierarchy, budget: usize, key: &dyn Fn(u32) -> f64) {
+    pub fn adapt(&mut self, h: &Hierarchy, budget: usize, key: &dyn Fn(u32) -> Key) {
         self.last_changes = 0;
         // updateErrorKeys: a new frame; every node on either side of the cut is re-keyed (nodes
         // that join a queue later are keyed when they join).
@@ -216,19 +255,18 @@ impl Cut {
             self.enqueue(n, key);
         }
         // The paper's loop: lower the smallest while over budget, raise the largest while within
-        // it, until the node just raised is lowered again. A step limit guards against cycles
-        // among equal keys.
+        // it, until the node just raised is lowered again — directly, or because lowering a node
+        // forced it. A step limit guards against longer cycles.
         let limit = 4 * h.node_count() + 16;
         let mut steps = 0;
         let mut lifted = NONE;
         loop {
-            let mut dropped_lifted = false;
             while self.triangles > budget {
                 let Some(drop) = self.peek_lower() else { break };
                 self.lower.pop();
-                dropped_lifted |= drop == lifted;
                 self.lower(h, drop, key);
             }
+            let dropped_lifted = lifted != NONE && self.applied[lifted as usize];
             if dropped_lifted || steps > limit {
                 break;
             }
@@ -244,11 +282,45 @@ impl Cut {
                 break;
             }
         }
+        self.fill(h, budget, key);
+    }
+
+    /// Best effort: the loop stops when a raise would only be undone, which can leave part of the
+    /// budget unused; spend it on the largest-error raises that need no other raise first (they
+    /// add exactly their own triangles) and still fit.
+    fn fill(&mut self, h: &Hierarchy, budget: usize, key: &dyn Fn(u32) -> Key) {
+        let mut skipped = Vec::new();
+        while self.triangles < budget {
+            let Some(lift) = self.pop_raise() else { break };
+            let grows = h.removed(lift).len().saturating_sub(h.created(lift).len());
+            let free = h
+                .dependents(lift)
+                .iter()
+                .all(|&d| !self.applied[d as usize]);
+            if free && self.triangles + grows <= budget {
+                self.raise(h, lift, key);
+            } else {
+                skipped.push(lift);
+            }
+        }
+        // Put the skipped nodes back so the queues stay complete for the next frame.
+        for n in skipped {
+            self.enqueue(n, key);
+        }
+    }
+
+    /// The largest key among the nodes that could be raised (the cut's error: for the
+    /// perceptual criterion, the LOD's imperceptibility distance), with this frame's keys.
+    pub fn error(&self, h: &Hierarchy, key: &dyn Fn(u32) -> Key) -> f64 {
+        (0..h.node_count() as u32)
+            .filter(|&n| self.raisable(n))
+            .map(|n| key(n)[0])
+            .fold(0.0, f64::max)
     }
 
     /// Refine the coarsest-first until every raisable node's key is at most `threshold` (a static
     /// LOD for a distance: every node that would be visible from `threshold` is refined).
-    pub fn refine_above(&mut self, h: &Hierarchy, threshold: f64, key: &dyn Fn(u32) -> f64) {
+    pub fn refine_above(&mut self, h: &Hierarchy, threshold: f64, key: &dyn Fn(u32) -> Key) {
         self.frame = self.frame.wrapping_add(1);
         self.raise.clear();
         self.lower.clear();
@@ -256,7 +328,7 @@ impl Cut {
             self.enqueue(n, key);
         }
         while let Some(lift) = self.pop_raise() {
-            if self.keys[lift as usize] <= threshold {
+            if self.keys[lift as usize][0] <= threshold {
                 break;
             }
             self.raise(h, lift, key);

@@ -48,6 +48,7 @@ pub enum Criterion {
     /// Texture deviation projected to pixels (view-dependent APS).
     ScreenSpace,
     /// Screen-space deviation, ×10 on the silhouette.
+    #[serde(rename = "silhouette-10")]
     Silhouette10,
 }
 
@@ -273,23 +274,31 @@ impl ViewModel {
         (self.ppd / (2.0 * px)).max(self.csf.peak_frequency())
     }
 
-    /// The imperceptibility distance of the node, metres.
-    pub fn distance(&self, d: &NodeData, m: &MaterialFacts) -> f64 {
+    /// The imperceptibility distance of the node, metres, and the same without the clamp of
+    /// the frequency at the CSF peak (which only breaks ties between clamped nodes).
+    pub fn distance(&self, d: &NodeData, m: &MaterialFacts) -> [f64; 2] {
         let vis = self.visibility(d);
         let c = self.contrast(d, vis, m);
-        let f = self.frequency(d);
+        let px = self.feature_pixels(d);
         match self.csf.max_visible_frequency(c) {
-            Some(ft) if f.is_finite() => self.distance_m * ft / f,
-            _ => 0.0,
+            Some(ft) if px > 0.0 => {
+                let f = self.ppd / (2.0 * px);
+                [
+                    self.distance_m * ft / f.max(self.csf.peak_frequency()),
+                    self.distance_m * ft / f,
+                ]
+            }
+            _ => [0.0, 0.0],
         }
     }
 
-    /// The node's error under `criterion` (larger refines first).
-    pub fn key(&self, criterion: Criterion, d: &NodeData, m: &MaterialFacts) -> f64 {
+    /// The node's error under `criterion` (larger refines first), with a tie-break.
+    pub fn key(&self, criterion: Criterion, d: &NodeData, m: &MaterialFacts) -> [f64; 2] {
+        let one = |k: f64| [k, 0.0];
         match criterion {
             Criterion::Perceptual => self.distance(d, m),
-            Criterion::ObjectSpace => d.deviation as f64,
-            Criterion::ScreenSpace | Criterion::Silhouette10 => match self.visibility(d) {
+            Criterion::ObjectSpace => one(d.deviation as f64),
+            Criterion::ScreenSpace | Criterion::Silhouette10 => one(match self.visibility(d) {
                 Visibility::OffScreen => 0.0,
                 v => {
                     let px = (d.deviation * self.pixels_per_unit(d)) as f64;
@@ -299,7 +308,7 @@ impl ViewModel {
                         px
                     }
                 }
-            },
+            }),
         }
     }
 

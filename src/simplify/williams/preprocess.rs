@@ -4,9 +4,12 @@
 //! widened by the normal map's tilt, §5.4), intrinsic luminance range of the texels covered (§5.2,
 //! through `texels.rs`) — and its texture deviation.
 //!
-//! Cumulative, not incremental (§5.2): a node's bounds merge the bounds of every triangle it
-//! removes, and a triangle made by an earlier node carries that node's bounds, so each node bounds
-//! all original triangles under it (conservatively: a superset of the patch).
+//! Cumulative, not incremental (§5.2): a node's bounds are those of the *original* triangles its
+//! patch corresponds to. Every original triangle is tracked, by its centroid, on the current
+//! triangle that holds it (the same correspondence as the texture deviation below); a node's bounds
+//! merge the original triangles on the triangles it removes, plus the face normals of its own
+//! removed and created triangles (§5.3: "a simplified surface may well contain sharper dihedral
+//! angles than the original").
 //!
 //! Texture deviation (§2.2; Cohen, Olano, Manocha 1998): the 3D distance between a point of the
 //! original surface and the point of the simplified surface with the same texture coordinate.
@@ -22,7 +25,7 @@ use std::collections::HashMap;
 use glam::{Vec2, Vec3};
 
 use super::bounds::{Ball, Cone, Range};
-use super::hierarchy::{Hierarchy, NONE};
+use super::hierarchy::Hierarchy;
 use super::texels::{LuminancePyramid, normal_map_tilt};
 use crate::mesh::surface_distance::point_triangle_distance2;
 use crate::metric::color::luminance;
@@ -99,14 +102,60 @@ fn triangle_data(h: &Hierarchy, materials: &[MaterialFacts], t: u32) -> NodeData
     }
 }
 
-fn merge(a: NodeData, b: &NodeData) -> NodeData {
+/// The cone around the mean axis of `cones` that holds them all (pairwise merging drifts and
+/// widens over many inputs; the mean axis keeps a flat patch's cone narrow). A patch whose normals
+/// cancel out gets the full sphere.
+fn cone_around_mean(cones: impl Iterator<Item = Cone> + Clone) -> Cone {
+    let Some(axis) = cones
+        .clone()
+        .filter(|c| !c.is_empty())
+        .map(|c| c.axis)
+        .sum::<Vec3>()
+        .try_normalize()
+    else {
+        return Cone::ALL;
+    };
+    let half = cones
+        .filter(|c| !c.is_empty())
+        .map(|c| c.axis.dot(axis).clamp(-1.0, 1.0).acos() + c.half_angle)
+        .fold(0.0f32, f32::max);
+    Cone {
+        axis,
+        half_angle: (half + 1e-5).min(std::f32::consts::PI),
+    }
+}
+
+/// Bounds of a node from its items: the patch's original triangles, then (from `own_from` on) the
+/// node's own triangles, whose texels do not count (§5.2: cumulative, from the original). The
+/// sphere is centred on the middle of the items' box.
+fn bound(items: &[NodeData], own_from: usize) -> NodeData {
+    let (lo, hi) = items.iter().fold(
+        (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
+        |(lo, hi), d| (lo.min(d.ball.center), hi.max(d.ball.center)),
+    );
+    let center = 0.5 * (lo + hi);
+    let radius = items
+        .iter()
+        .map(|d| d.ball.center.distance(center) + d.ball.radius.max(0.0))
+        .fold(0.0f32, f32::max);
+    let mut luminance = items[..own_from]
+        .iter()
+        .fold(Range::EMPTY, |r, d| r.merge(d.luminance));
+    if luminance.is_empty() {
+        luminance = items[own_from..]
+            .iter()
+            .fold(Range::EMPTY, |r, d| r.merge(d.luminance));
+    }
     NodeData {
-        ball: a.ball.merge(b.ball),
-        silhouette: a.silhouette.merge(b.silhouette),
-        shading: a.shading.merge(b.shading),
-        luminance: a.luminance.merge(b.luminance),
-        deviation: a.deviation.max(b.deviation),
-        material: a.material,
+        ball: Ball {
+            center,
+            radius: radius * (1.0 + 1e-6),
+        },
+        silhouette: cone_around_mean(items.iter().map(|d| d.silhouette)),
+        shading: cone_around_mean(items.iter().map(|d| d.shading)),
+        luminance,
+        deviation: 0.0,
+        material: items[own_from].material,
     }
 }
 
@@ -157,56 +206,57 @@ pub fn preprocess(h: &Hierarchy) -> Preprocessed {
         .collect();
     let textured = h.original.uvs().is_some() && materials.iter().any(|m| m.pyramid.is_some());
 
-    // The original vertices, each on one original triangle.
-    let mut points: Vec<(Vec3, Vec2)> = Vec::new();
+    // Samples: the original vertices (texture deviation only) and the original triangles'
+    // centroids (deviation, and the triangle's bounds), each on the current triangle holding it.
+    let mut samples: Vec<(Vec3, Vec2, Option<NodeData>)> = Vec::new();
     let mut on_tri: Vec<Vec<u32>> = vec![Vec::new(); h.tris.len()];
     let mut seen: HashMap<[u32; 3], ()> = HashMap::new();
     for t in 0..h.original_triangles {
-        for k in h.tris[t].corners {
-            let c = h.corners[k as usize];
+        let c = h.tris[t].corners.map(|k| h.corners[k as usize]);
+        for k in c {
             if seen
-                .insert(c.position.to_array().map(f32::to_bits), ())
+                .insert(k.position.to_array().map(f32::to_bits), ())
                 .is_none()
             {
-                on_tri[t].push(points.len() as u32);
-                points.push((c.position, c.uv));
+                on_tri[t].push(samples.len() as u32);
+                samples.push((k.position, k.uv, None));
             }
         }
+        on_tri[t].push(samples.len() as u32);
+        samples.push((
+            (c[0].position + c[1].position + c[2].position) / 3.0,
+            (c[0].uv + c[1].uv + c[2].uv) / 3.0,
+            Some(triangle_data(h, &materials, t as u32)),
+        ));
     }
 
     let mut nodes: Vec<NodeData> = Vec::with_capacity(h.node_count());
     for n in 0..h.node_count() as u32 {
         let removed = h.removed(n);
-        let mut data: Option<NodeData> = None;
-        for &t in removed {
-            let tri = h.tris[t as usize];
-            let d = if tri.creator == NONE {
-                triangle_data(h, &materials, t)
-            } else {
-                nodes[tri.creator as usize]
-            };
-            data = Some(match data {
-                None => d,
-                Some(acc) => merge(acc, &d),
-            });
-        }
-        let mut data = data.expect("a collapse removes triangles");
-        data.material = h.tris[removed[0] as usize].material;
         let created = h.created(n);
-        for &t in created {
-            let p = h.positions(t);
-            data.silhouette = data
-                .silhouette
-                .merge(Cone::of((p[1] - p[0]).cross(p[2] - p[0])));
-            data.ball = data.ball.merge(Ball::of_points(&p));
-            for k in h.tris[t as usize].corners {
-                data.shading = data.shading.merge(
-                    Cone::of(h.corners[k as usize].normal)
-                        .widen(materials[h.tris[t as usize].material as usize].tilt),
-                );
-            }
+        // Deviation never shrinks going coarser: start from the prerequisites'.
+        let mut deviation = h
+            .prerequisites(n)
+            .iter()
+            .map(|&p| nodes[p as usize].deviation)
+            .fold(0.0, f32::max);
+        let moving: Vec<u32> = removed
+            .iter()
+            .flat_map(|&t| std::mem::take(&mut on_tri[t as usize]))
+            .collect();
+        // The patch's original triangles, and the node's own triangles (their geometry and
+        // normals, not their texels).
+        let mut items: Vec<NodeData> = moving
+            .iter()
+            .filter_map(|&q| samples[q as usize].2)
+            .collect();
+        let own_from = items.len();
+        for &t in removed.iter().chain(created) {
+            items.push(triangle_data(h, &materials, t));
         }
-        // Texture deviation: move the patch's points onto the new triangles.
+        let mut data = bound(&items, own_from);
+        data.material = h.tris[removed[0] as usize].material;
+        // Texture deviation: move the patch's samples onto the new triangles.
         let patch: Vec<[(Vec3, Vec2); 3]> = created
             .iter()
             .map(|&t| {
@@ -216,15 +266,12 @@ pub fn preprocess(h: &Hierarchy) -> Preprocessed {
                 })
             })
             .collect();
-        let mut deviation = data.deviation;
         if !patch.is_empty() {
-            for &t in removed {
-                for q in std::mem::take(&mut on_tri[t as usize]) {
-                    let (p, uv) = points[q as usize];
-                    let (i, d) = place(p, textured.then_some(uv), &patch);
-                    deviation = deviation.max(d);
-                    on_tri[created[i] as usize].push(q);
-                }
+            for q in moving {
+                let (p, uv, _) = samples[q as usize];
+                let (i, d) = place(p, textured.then_some(uv), &patch);
+                deviation = deviation.max(d);
+                on_tri[created[i] as usize].push(q);
             }
         }
         data.deviation = deviation;

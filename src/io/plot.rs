@@ -1,0 +1,90 @@
+//! SVG line plots for the paper experiments (energy against evaluations, error against budget):
+//! linear axes from zero, one colour per series (pairs of solid and dashed series share one when
+//! any series is dashed), a legend on the right.
+
+use std::fmt::Write as _;
+
+/// A plotted series: name, points, dashed.
+pub type Series = (String, Vec<(f64, f64)>, bool);
+
+const COLORS: [&str; 8] = [
+    "#1b9e77", "#d95f02", "#7570b3", "#e7298a", "#66a61e", "#e6ab02", "#a6761d", "#666666",
+];
+
+/// A line plot: series of (name, points, dashed), linear axes from zero.
+pub fn line_plot(title: &str, x_label: &str, y_label: &str, series: &[Series]) -> String {
+    let (w, h, ml, mr, mt, mb) = (720.0, 420.0, 80.0, 220.0, 40.0, 50.0);
+    let all = series.iter().flat_map(|s| s.1.iter());
+    let x_max = all.clone().map(|p| p.0).fold(0.0f64, f64::max).max(1e-12) * 1.05;
+    let y_max = all.map(|p| p.1).fold(0.0f64, f64::max).max(1e-12) * 1.1;
+    let px = |x: f64| ml + x / x_max * (w - ml - mr);
+    let py = |y: f64| h - mb - y / y_max * (h - mt - mb);
+    let mut s = String::new();
+    let _ = writeln!(
+        s,
+        "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"{w}\" height=\"{h}\" font-family=\"sans-serif\" font-size=\"12\"><rect width=\"{w}\" height=\"{h}\" fill=\"#fff\"/><text x=\"{ml}\" y=\"24\" font-size=\"15\">{title}</text><rect x=\"{ml}\" y=\"{mt}\" width=\"{}\" height=\"{}\" fill=\"none\" stroke=\"#888\"/>",
+        w - ml - mr,
+        h - mt - mb
+    );
+    for k in 0..=4 {
+        let (x, y) = (x_max * k as f64 / 4.0, y_max * k as f64 / 4.0);
+        let _ = writeln!(
+            s,
+            "<text x=\"{:.1}\" y=\"{:.1}\" text-anchor=\"middle\">{}</text><text x=\"{:.1}\" y=\"{:.1}\" text-anchor=\"end\">{:.3e}</text><line x1=\"{ml}\" x2=\"{:.1}\" y1=\"{:.1}\" y2=\"{:.1}\" stroke=\"#eee\"/>",
+            px(x),
+            h - mb + 16.0,
+            x.round(),
+            ml - 4.0,
+            py(y) + 4.0,
+            y,
+            w - mr,
+            py(y),
+            py(y)
+        );
+    }
+    for (k, (name, pts, dashed)) in series.iter().enumerate() {
+        let color = COLORS[(k / if series.iter().any(|s| s.2) { 2 } else { 1 }) % COLORS.len()];
+        let dash = if *dashed {
+            " stroke-dasharray=\"6 4\""
+        } else {
+            ""
+        };
+        let mut pts = pts.clone();
+        pts.sort_by(|a, b| a.0.total_cmp(&b.0));
+        let line: Vec<String> = pts
+            .iter()
+            .map(|p| format!("{:.1},{:.1}", px(p.0), py(p.1)))
+            .collect();
+        let _ = writeln!(
+            s,
+            "<polyline points=\"{}\" fill=\"none\" stroke=\"{color}\" stroke-width=\"2\"{dash}/>",
+            line.join(" ")
+        );
+        for p in &pts {
+            let _ = writeln!(
+                s,
+                "<circle cx=\"{:.1}\" cy=\"{:.1}\" r=\"2.5\" fill=\"{color}\"/>",
+                px(p.0),
+                py(p.1)
+            );
+        }
+        let ly = mt + 16.0 * k as f64 + 8.0;
+        let _ = writeln!(
+            s,
+            "<line x1=\"{0:.1}\" x2=\"{1:.1}\" y1=\"{ly:.1}\" y2=\"{ly:.1}\" stroke=\"{color}\" stroke-width=\"2\"{dash}/><text x=\"{2:.1}\" y=\"{3:.1}\">{name}</text>",
+            w - mr + 10.0,
+            w - mr + 34.0,
+            w - mr + 40.0,
+            ly + 4.0
+        );
+    }
+    let _ = writeln!(
+        s,
+        "<text x=\"{:.1}\" y=\"{:.1}\" text-anchor=\"middle\">{x_label}</text><text x=\"16\" y=\"{:.1}\" transform=\"rotate(-90 16 {:.1})\" text-anchor=\"middle\">{y_label}</text></svg>",
+        (ml + w - mr) / 2.0,
+        h - 10.0,
+        h / 2.0,
+        h / 2.0
+    );
+    s
+}

@@ -1,0 +1,113 @@
+//! `lodeval simplify --method williams` (Williams et al. 2003) end to end, its bad inputs, and the
+//! paper experiment on a tiny config.
+
+use crate::common::{lodeval, model};
+
+fn simplify(dir: &std::path::Path, threads: &str, extra: &[&str]) -> (crate::common::Run, Vec<u8>) {
+    let original = model("bunny/bunny_odedstein_3k.obj");
+    // One folder per thread count: the OBJ names its MTL file, so the file name must not differ.
+    let out = dir.join(format!("t{threads}")).join("w.obj");
+    std::fs::create_dir_all(out.parent().unwrap()).unwrap();
+    let mut args = vec![
+        "--threads",
+        threads,
+        "simplify",
+        original.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+        "--method",
+        "williams",
+    ];
+    args.extend_from_slice(extra);
+    let r = lodeval(args);
+    let bytes = std::fs::read(&out).unwrap_or_default();
+    (r, bytes)
+}
+
+#[test]
+fn a_view_dependent_lod_within_budget_identical_for_any_thread_count() {
+    let dir = tempfile::tempdir().unwrap();
+    let (r1, a) = simplify(dir.path(), "1", &["--budget", "800"]);
+    assert_eq!(r1.code, 0, "{}", r1.stderr);
+    let tris = a
+        .split(|&b| b == b'\n')
+        .filter(|l| l.starts_with(b"f "))
+        .count();
+    assert!(
+        (700..=800).contains(&tris),
+        "{tris} triangles for a budget of 800"
+    );
+    for t in ["2", "8"] {
+        let (r, b) = simplify(dir.path(), t, &["--budget", "800"]);
+        assert_eq!(r.code, 0, "{}", r.stderr);
+        assert!(a == b, "--threads {t} changed the LOD");
+    }
+    // Another view gives another LOD; an explicit camera and the static all-views LOD work too.
+    let (r, c) = simplify(dir.path(), "1", &["--budget", "800", "--view", "7"]);
+    assert_eq!(r.code, 0, "{}", r.stderr);
+    assert!(a != c, "view 7 gave view 0's LOD");
+    let (r, _) = simplify(dir.path(), "1", &["--budget", "800", "--camera", "0,0.1,1"]);
+    assert_eq!(r.code, 0, "{}", r.stderr);
+    let (r, _) = simplify(
+        dir.path(),
+        "1",
+        &[
+            "--budget",
+            "800",
+            "--all-views",
+            "--criterion",
+            "screen-space",
+        ],
+    );
+    assert_eq!(r.code, 0, "{}", r.stderr);
+}
+
+#[test]
+fn bad_williams_requests_exit_2_and_write_nothing() {
+    let dir = tempfile::tempdir().unwrap();
+    for extra in [
+        &[][..],
+        &["--budget", "800", "--camera", "1,2,3,4"][..],
+        &["--budget", "800", "--criterion", "psnr"][..],
+        &["--budget", "800", "--view", "99"][..],
+        &["--budget", "800", "--shading", "toon"][..],
+        &["--budget", "800", "--camera", "0,0,0,0,0,0"][..],
+    ] {
+        let (r, bytes) = simplify(dir.path(), "1", extra);
+        assert_eq!(r.code, 2, "{extra:?}: {}", r.stderr);
+        assert!(r.stderr.contains("--"), "{extra:?}: {}", r.stderr);
+        assert!(bytes.is_empty(), "{extra:?} wrote a file");
+    }
+}
+
+#[test]
+fn the_paper_experiment_runs_from_a_config() {
+    let dir = tempfile::tempdir().unwrap();
+    let config = dir.path().join("w.toml");
+    std::fs::write(
+        &config,
+        format!(
+            "out = \"out\"\nbudgets = [0.1]\nsingle_size = 96\nmean_size = 64\nrig = \"fibonacci:3\"\n\
+             [[scene]]\nname = \"b\"\nmesh = \"{}\"\nshading = \"gouraud\"\n",
+            model("bunny/bunny_odedstein_3k.obj").display()
+        ),
+    )
+    .unwrap();
+    let r = lodeval(["simplify", "--experiment", config.to_str().unwrap()]);
+    assert_eq!(r.code, 0, "{}", r.stderr);
+    let summary = std::fs::read_to_string(dir.path().join("out/summary.csv")).unwrap();
+    // Header plus one row per criterion.
+    assert_eq!(summary.lines().count(), 5, "{summary}");
+    for f in ["results.csv", "preprocess.csv", "b.svg", "b-sheet.png"] {
+        assert!(dir.path().join("out").join(f).exists(), "{f}");
+    }
+    // An unknown key is an input error naming the file.
+    std::fs::write(
+        &config,
+        "out = \"o\"\nbudgets = [0.1]\nscene = []\nbogus = 1\n",
+    )
+    .unwrap();
+    let r = lodeval(["simplify", "--experiment", config.to_str().unwrap()]);
+    assert_eq!(r.code, 2, "{}", r.stderr);
+    assert!(r.stderr.contains("w.toml"), "{}", r.stderr);
+}
