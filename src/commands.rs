@@ -646,8 +646,9 @@ pub struct WilliamsJob {
     pub mesh: PathBuf,
     /// Output `.obj`.
     pub out: PathBuf,
-    /// Triangle budget.
-    pub budget: usize,
+    /// A triangle budget, or a viewing distance (metres) from which the LOD is to be
+    /// imperceptible.
+    pub goal: crate::simplify::williams::StaticGoal,
     /// Views.
     pub views: WilliamsViews,
     /// Shading the LOD is for.
@@ -660,7 +661,7 @@ pub struct WilliamsJob {
 
 /// Simplify with Williams et al. 2003 and write the LOD as OBJ.
 pub fn simplify_williams(job: &WilliamsJob) -> Result<Vec<SimplifyRow>> {
-    use crate::simplify::williams::{Cut, Options, StaticGoal, Williams};
+    use crate::simplify::williams::{Options, Williams};
     if job.out.extension().and_then(|e| e.to_str()) != Some("obj") {
         return Err(Error::Usage(format!(
             "-o {}: lodeval writes LODs as .obj (with .mtl and textures beside it)",
@@ -676,20 +677,13 @@ pub fn simplify_williams(job: &WilliamsJob) -> Result<Vec<SimplifyRow>> {
         size: (job.size, job.size),
         ..Options::default()
     };
-    let lod = match &job.views {
-        WilliamsViews::All(rig) => w.static_lod(
-            &rig_cameras(&mesh, rig, 1.0),
-            StaticGoal::Budget(job.budget),
-            &opts,
-        )?,
+    let cameras = match &job.views {
+        WilliamsViews::All(rig) => rig_cameras(&mesh, rig, 1.0),
         WilliamsViews::One(rig, k) => {
             let cams = rig_cameras(&mesh, rig, 1.0);
-            let cam = cams.get(*k).ok_or_else(|| {
+            vec![*cams.get(*k).ok_or_else(|| {
                 Error::Usage(format!("--view {k}: the rig has views 0..{}", cams.len()))
-            })?;
-            let mut cut = Cut::coarsest(&w.hierarchy);
-            w.adapt(&mut cut, cam, job.budget, &opts);
-            w.mesh(&cut)?
+            })?]
         }
         WilliamsViews::Camera(eye, target) => {
             let sphere = mesh.bounding_sphere();
@@ -711,11 +705,10 @@ pub fn simplify_williams(job: &WilliamsJob) -> Result<Vec<SimplifyRow>> {
             let dist = eye.distance(sphere.center);
             cam.near = (dist - sphere.radius).max(dist * 1e-3);
             cam.far = dist + sphere.radius;
-            let mut cut = Cut::coarsest(&w.hierarchy);
-            w.adapt(&mut cut, &cam, job.budget, &opts);
-            w.mesh(&cut)?
+            vec![cam]
         }
     };
+    let lod = w.static_lod(&cameras, job.goal, &opts)?;
     let seconds = start.elapsed().as_secs_f64();
     crate::mesh::write_obj::write(&lod, &job.out)?;
     Ok(vec![SimplifyRow {

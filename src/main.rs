@@ -302,8 +302,12 @@ struct SimplifyArgs {
     #[arg(long, default_value = "qem")]
     method: String,
     /// williams: triangle budget.
-    #[arg(long, conflicts_with_all = ["ratio", "triangles", "error", "chain"])]
+    #[arg(long, conflicts_with_all = ["ratio", "triangles", "error", "chain", "distance"])]
     budget: Option<usize>,
+    /// williams: instead of a budget, refine until the LOD is imperceptible from this viewing
+    /// distance in metres (the display and viewer of DESIGN.md's viewing conditions).
+    #[arg(long, conflicts_with_all = ["ratio", "triangles", "error", "chain"])]
+    distance: Option<f64>,
     /// williams: the camera, as EX,EY,EZ (looking at the model's centre, default field of view) or
     /// EX,EY,EZ,TX,TY,TZ. Default: view 0 of the default rig at the default framing.
     #[arg(long, value_delimiter = ',', num_args = 1, conflicts_with_all = ["view", "all_views"])]
@@ -967,9 +971,21 @@ fn williams_job(a: &SimplifyArgs) -> Result<lodeval::commands::WilliamsJob, Erro
             )));
         }
     };
-    let budget = a
-        .budget
-        .ok_or_else(|| Error::Usage("--method williams needs --budget N (triangles)".into()))?;
+    use lodeval::simplify::williams::StaticGoal;
+    let goal = match (a.budget, a.distance) {
+        (Some(b), _) => StaticGoal::Budget(b),
+        (None, Some(d)) if d.is_finite() && d > 0.0 => StaticGoal::Distance(d),
+        (None, Some(d)) => {
+            return Err(Error::Usage(format!(
+                "--distance {d}: give a positive distance in metres"
+            )));
+        }
+        (None, None) => {
+            return Err(Error::Usage(
+                "--method williams needs --budget N (triangles) or --distance METRES".into(),
+            ));
+        }
+    };
     if a.size == 0 || a.size > 16384 {
         return Err(Error::Usage(format!(
             "--size {}: use 1..16384 pixels",
@@ -979,7 +995,7 @@ fn williams_job(a: &SimplifyArgs) -> Result<lodeval::commands::WilliamsJob, Erro
     Ok(lodeval::commands::WilliamsJob {
         mesh: a.mesh.clone().expect("clap requires it"),
         out: a.out.clone().expect("clap requires it"),
-        budget,
+        goal,
         views,
         shading,
         criterion,

@@ -111,3 +111,48 @@ fn the_paper_experiment_runs_from_a_config() {
     assert_eq!(r.code, 2, "{}", r.stderr);
     assert!(r.stderr.contains("w.toml"), "{}", r.stderr);
 }
+
+#[test]
+fn eval_generates_williams_lods_within_budget() {
+    // `generate = { method = "williams" }`: one static LOD per ratio for the rig's views.
+    let dir = tempfile::tempdir().unwrap();
+    let text = format!(
+        "out = \"out\"\nmetrics = [\"flip\"]\ngeometry_samples = 0\n[render]\nsize = 64\nrig = \"icosahedron\"\n[distance]\nenabled = false\n[[asset]]\nname = \"w\"\nmesh = \"{}\"\ngenerate = {{ method = \"williams\", ratios = [0.5, 0.1] }}\n",
+        model("bunny/bunny_odedstein_3k.obj").display()
+    );
+    let cfg = dir.path().join("g.toml");
+    std::fs::write(&cfg, text).unwrap();
+    let r = lodeval(["eval", cfg.to_str().unwrap()]);
+    assert_eq!(r.code, 0, "{}", r.stderr);
+    let lods = std::fs::read_to_string(dir.path().join("out/lods.csv")).unwrap();
+    let header: Vec<&str> = lods.lines().next().unwrap().split(',').collect();
+    let col = header.iter().position(|h| *h == "triangles").unwrap();
+    let rows: Vec<Vec<&str>> = lods
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').collect())
+        .collect();
+    for (name, budget) in [("williams-r50", 3299), ("williams-r10", 660)] {
+        let row = rows
+            .iter()
+            .find(|r| r.contains(&name))
+            .unwrap_or_else(|| panic!("{name}: {lods}"));
+        let t: usize = row[col].parse().unwrap();
+        assert!(
+            t <= budget && t + 8 >= budget,
+            "{name}: {t} triangles for {budget}"
+        );
+    }
+    // The coarser LOD has the larger mean FLIP (summary.csv: asset,lod,…,metric,mean,…).
+    let summary = std::fs::read_to_string(dir.path().join("out/summary.csv")).unwrap();
+    let flip = |lod: &str| -> f64 {
+        summary
+            .lines()
+            .map(|l| l.split(',').collect::<Vec<_>>())
+            .find(|r| r[1] == lod && r[4] == "flip")
+            .unwrap_or_else(|| panic!("{lod}: {summary}"))[5]
+            .parse()
+            .unwrap()
+    };
+    assert!(flip("williams-r50") < flip("williams-r10"));
+}

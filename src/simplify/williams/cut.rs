@@ -137,15 +137,29 @@ impl Cut {
         self.keys[n as usize]
     }
 
-    fn enqueue(&mut self, n: u32, key: &dyn Fn(u32) -> Key) {
-        if self.raisable(n) || self.lowerable(n) {
-            self.key_of(n, key);
+    /// What lowering `n` costs: the largest key among `n` and the unapplied prerequisites its
+    /// lowering forces first. Without this, the node with the smallest key is often one whose
+    /// lowering re-applies the node just raised, and the loop stops after one step.
+    fn lower_key(&mut self, h: &Hierarchy, n: u32, key: &dyn Fn(u32) -> Key) -> Key {
+        let mut k = self.key_of(n, key);
+        for &p in h.prerequisites(n) {
+            if !self.applied[p as usize] {
+                let kp = self.key_of(p, key);
+                if key_cmp(&kp, &k) == Ordering::Greater {
+                    k = kp;
+                }
+            }
         }
+        k
+    }
+
+    fn enqueue(&mut self, h: &Hierarchy, n: u32, key: &dyn Fn(u32) -> Key) {
         if self.raisable(n) {
-            self.raise.push(Entry(self.keys[n as usize], n));
+            let k = self.key_of(n, key);
+            self.raise.push(Entry(k, n));
         } else if self.lowerable(n) {
-            self.lower
-                .push(std::cmp::Reverse(Entry(self.keys[n as usize], n)));
+            let k = self.lower_key(h, n, key);
+            self.lower.push(std::cmp::Reverse(Entry(k, n)));
         }
     }
 
@@ -179,7 +193,7 @@ impl Cut {
         touched.sort_unstable();
         touched.dedup();
         for m in touched {
-            self.enqueue(m, key);
+            self.enqueue(h, m, key);
         }
         self.last_changes += 1;
     }
@@ -233,9 +247,9 @@ impl Cut {
         None
     }
 
-    fn peek_lower(&mut self) -> Option<u32> {
+    fn peek_lower(&mut self, h: &Hierarchy, key: &dyn Fn(u32) -> Key) -> Option<u32> {
         while let Some(std::cmp::Reverse(Entry(k, n))) = self.lower.peek().copied() {
-            if self.lowerable(n) && k == self.keys[n as usize] {
+            if self.lowerable(n) && k == self.lower_key(h, n, key) {
                 return Some(n);
             }
             self.lower.pop();
@@ -252,7 +266,7 @@ impl Cut {
         self.raise.clear();
         self.lower.clear();
         for n in 0..h.node_count() as u32 {
-            self.enqueue(n, key);
+            self.enqueue(h, n, key);
         }
         // The paper's loop: lower the smallest while over budget, raise the largest while within
         // it, until the node just raised is lowered again — directly, or because lowering a node
@@ -262,7 +276,9 @@ impl Cut {
         let mut lifted = NONE;
         loop {
             while self.triangles > budget {
-                let Some(drop) = self.peek_lower() else { break };
+                let Some(drop) = self.peek_lower(h, key) else {
+                    break;
+                };
                 self.lower.pop();
                 self.lower(h, drop, key);
             }
@@ -305,7 +321,7 @@ impl Cut {
         }
         // Put the skipped nodes back so the queues stay complete for the next frame.
         for n in skipped {
-            self.enqueue(n, key);
+            self.enqueue(h, n, key);
         }
     }
 
@@ -325,7 +341,7 @@ impl Cut {
         self.raise.clear();
         self.lower.clear();
         for n in 0..h.node_count() as u32 {
-            self.enqueue(n, key);
+            self.enqueue(h, n, key);
         }
         while let Some(lift) = self.pop_raise() {
             if self.keys[lift as usize][0] <= threshold {

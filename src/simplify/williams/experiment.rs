@@ -13,8 +13,8 @@
 //! Writes `results.csv` (one row per scene, criterion, budget, view and size), `summary.csv` (view
 //! 0 and the mean per scene, criterion and budget), `preprocess.csv` (hierarchy build and
 //! preprocessing time per scene), one SVG per scene (`SCENE.svg`: FLIP and VDP JND against budget),
-//! and a contact sheet per scene at the smallest budget (`SCENE-sheet.png`: original and each
-//! criterion's view-0 LOD).
+//! and a contact sheet per scene at the smallest budget (`SCENE-sheet.png`: the original and each
+//! criterion's LOD, view 0 at `mean_size`).
 
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -257,15 +257,18 @@ pub fn run(config: &Path, log: &mut dyn FnMut(&str)) -> Result<Vec<SummaryRow>> 
         let scene = Scene::new(original.clone());
         let single = settings(exp.single_size, exp.samples, shading);
         let mean = settings(exp.mean_size, exp.samples, shading);
-        let single_frame = raster::render(&scene, &cameras[0], &single)?;
-        let single_ref = scorer.prepare(linear(&single_frame)?);
-        let mean_refs = cameras
-            .iter()
-            .map(|c| Ok(scorer.prepare(linear(&raster::render(&scene, c, &mean)?)?)))
-            .collect::<Result<Vec<_>>>()?;
+        let single_ref = scorer.prepare(linear(&raster::render(&scene, &cameras[0], &single)?)?);
+        let mut sheet = Vec::new();
+        let mut mean_refs = Vec::new();
+        for c in &cameras {
+            let frame = raster::render(&scene, c, &mean)?;
+            mean_refs.push(scorer.prepare(linear(&frame)?));
+            if sheet.is_empty() {
+                sheet.push(frame);
+            }
+        }
         let n = original.triangle_count();
         let smallest = exp.budgets.iter().copied().fold(1.0, f64::min);
-        let mut sheet = vec![single_frame];
         for &criterion in &exp.criteria {
             let opts = |size: u32| Options {
                 shading,
@@ -281,11 +284,7 @@ pub fn run(config: &Path, log: &mut dyn FnMut(&str)) -> Result<Vec<SummaryRow>> 
                 w.adapt(&mut cut, &cameras[0], budget, &opts(exp.single_size));
                 let lod = w.mesh(&cut)?;
                 let triangles = lod.triangle_count();
-                let (flip, vdp, jnd, frame) =
-                    score(&scorer, &single_ref, lod, &cameras[0], &single)?;
-                if ratio == smallest {
-                    sheet.push(frame);
-                }
+                let (flip, vdp, jnd, _) = score(&scorer, &single_ref, lod, &cameras[0], &single)?;
                 rows.push(Row {
                     scene: spec.name.clone(),
                     criterion: criterion.name().into(),
@@ -309,7 +308,11 @@ pub fn run(config: &Path, log: &mut dyn FnMut(&str)) -> Result<Vec<SummaryRow>> 
                     w.adapt(&mut cut, camera, budget, &opts(exp.mean_size));
                     let lod = w.mesh(&cut)?;
                     let triangles = lod.triangle_count();
-                    let (flip, vdp, jnd, _) = score(&scorer, &mean_refs[v], lod, camera, &mean)?;
+                    let (flip, vdp, jnd, frame) =
+                        score(&scorer, &mean_refs[v], lod, camera, &mean)?;
+                    if v == 0 && ratio == smallest {
+                        sheet.push(frame);
+                    }
                     sum_flip += flip;
                     sum_jnd += jnd;
                     rows.push(Row {

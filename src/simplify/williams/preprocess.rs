@@ -20,8 +20,6 @@
 //! paper falls back to). The node's deviation is the largest distance so found, and at least its
 //! prerequisites' (deviation never shrinks going coarser).
 
-use std::collections::HashMap;
-
 use glam::{Vec2, Vec3};
 
 use super::bounds::{Ball, Cone, Range};
@@ -210,19 +208,16 @@ pub fn preprocess(h: &Hierarchy) -> Preprocessed {
     // centroids (deviation, and the triangle's bounds), each on the current triangle holding it.
     let mut samples: Vec<(Vec3, Vec2, Option<NodeData>)> = Vec::new();
     let mut on_tri: Vec<Vec<u32>> = vec![Vec::new(); h.tris.len()];
-    let mut seen: HashMap<[u32; 3], ()> = HashMap::new();
-    for t in 0..h.original_triangles {
+    let mut seen: std::collections::HashSet<[u32; 3]> = std::collections::HashSet::new();
+    for (t, held) in on_tri.iter_mut().enumerate().take(h.original_triangles) {
         let c = h.tris[t].corners.map(|k| h.corners[k as usize]);
         for k in c {
-            if seen
-                .insert(k.position.to_array().map(f32::to_bits), ())
-                .is_none()
-            {
-                on_tri[t].push(samples.len() as u32);
+            if seen.insert(k.position.to_array().map(f32::to_bits)) {
+                held.push(samples.len() as u32);
                 samples.push((k.position, k.uv, None));
             }
         }
-        on_tri[t].push(samples.len() as u32);
+        held.push(samples.len() as u32);
         samples.push((
             (c[0].position + c[1].position + c[2].position) / 3.0,
             (c[0].uv + c[1].uv + c[2].uv) / 3.0,
