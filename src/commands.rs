@@ -585,15 +585,20 @@ pub struct SimplifyRow {
     pub seconds: f64,
 }
 
-/// Simplify a mesh and write the LOD(s) as OBJ.
-pub fn simplify(job: &SimplifyJob) -> Result<Vec<SimplifyRow>> {
-    if job.out.extension().and_then(|e| e.to_str()) != Some("obj") {
+/// Check that `out` is an OBJ path, then load `input` (the simplifiers' common start).
+fn load_for_lod(input: &Path, out: &Path) -> Result<Mesh> {
+    if out.extension().and_then(|e| e.to_str()) != Some("obj") {
         return Err(Error::Usage(format!(
             "-o {}: lodeval writes LODs as .obj (with .mtl and textures beside it)",
-            job.out.display()
+            out.display()
         )));
     }
-    let mesh = mesh::load(&job.mesh, &LoadOptions::default())?;
+    mesh::load(input, &LoadOptions::default())
+}
+
+/// Simplify a mesh and write the LOD(s) as OBJ.
+pub fn simplify(job: &SimplifyJob) -> Result<Vec<SimplifyRow>> {
+    let mesh = load_for_lod(&job.mesh, &job.out)?;
     let start = std::time::Instant::now();
     let lods = crate::simplify::chain(&mesh, job.method, &job.goals)?;
     let seconds = start.elapsed().as_secs_f64();
@@ -662,13 +667,7 @@ pub struct WilliamsJob {
 /// Simplify with Williams et al. 2003 and write the LOD as OBJ.
 pub fn simplify_williams(job: &WilliamsJob) -> Result<Vec<SimplifyRow>> {
     use crate::simplify::williams::{Options, Williams};
-    if job.out.extension().and_then(|e| e.to_str()) != Some("obj") {
-        return Err(Error::Usage(format!(
-            "-o {}: lodeval writes LODs as .obj (with .mtl and textures beside it)",
-            job.out.display()
-        )));
-    }
-    let mesh = mesh::load(&job.mesh, &LoadOptions::default())?;
+    let mesh = load_for_lod(&job.mesh, &job.out)?;
     let start = std::time::Instant::now();
     let w = Williams::build(&mesh)?;
     let opts = Options {

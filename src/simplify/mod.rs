@@ -14,6 +14,23 @@ pub mod williams;
 use crate::error::{Error, Result};
 use crate::mesh::Mesh;
 
+/// A paper experiment's TOML config: `T` parsed from `config`, or an input error naming the file
+/// and pointing at `schema` (the shipped config that documents the keys).
+pub(crate) fn read_experiment<T: serde::de::DeserializeOwned>(
+    config: &std::path::Path,
+    schema: &str,
+) -> Result<T> {
+    let text = String::from_utf8(crate::mesh::read_file(config)?)
+        .map_err(|_| Error::input(config, "the config is not UTF-8 text", "save it as UTF-8"))?;
+    toml::from_str(&text).map_err(|e| {
+        Error::input(
+            config,
+            e.message().trim().to_string(),
+            format!("fix the key or value (see {schema} for the schema)"),
+        )
+    })
+}
+
 /// A simplification method.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Deserialize, serde::Serialize)]
 #[serde(rename_all = "lowercase")]

@@ -106,15 +106,8 @@ pub struct ResultRow {
 
 /// Run the experiment in `config`; `log` receives one line per finished run.
 pub fn run(config: &Path, log: &mut dyn FnMut(&str)) -> Result<Vec<ResultRow>> {
-    let text = String::from_utf8(crate::mesh::read_file(config)?)
-        .map_err(|_| Error::input(config, "the config is not UTF-8 text", "save it as UTF-8"))?;
-    let exp: Experiment = toml::from_str(&text).map_err(|e| {
-        Error::input(
-            config,
-            e.message().trim().to_string(),
-            "fix the key or value (see configs/papers/lindstrom-turk.toml for the schema)",
-        )
-    })?;
+    let exp: Experiment =
+        crate::simplify::read_experiment(config, "configs/papers/lindstrom-turk.toml")?;
     let base = config.parent().unwrap_or(Path::new("."));
     let out = base.join(&exp.out);
     for d in ["energy", "meshes"] {

@@ -158,15 +158,8 @@ pub struct PreprocessRow {
 
 /// Parse a config file.
 pub fn load(config: &Path) -> Result<Experiment> {
-    let text = String::from_utf8(crate::mesh::read_file(config)?)
-        .map_err(|_| Error::input(config, "the config is not UTF-8 text", "save it as UTF-8"))?;
-    let exp: Experiment = toml::from_str(&text).map_err(|e| {
-        Error::input(
-            config,
-            e.message().trim().to_string(),
-            "fix the key or value (see configs/papers/williams2003.toml for the schema)",
-        )
-    })?;
+    let exp: Experiment =
+        crate::simplify::read_experiment(config, "configs/papers/williams2003.toml")?;
     if exp.budgets.iter().any(|&b| !(b > 0.0 && b <= 1.0)) {
         return Err(Error::input(
             config,
