@@ -14,7 +14,7 @@
 //! 0 and the mean per scene, criterion and budget), `preprocess.csv` (hierarchy build and
 //! preprocessing time per scene), one SVG per scene (`SCENE.svg`: FLIP and VDP JND against budget),
 //! and a contact sheet per scene at the smallest budget (`SCENE-sheet.png`: the original and each
-//! criterion's LOD, view 0 at `mean_size`).
+//! criterion's LOD, view 0 at `mean_size`, shown at most [`SHEET_SIZE`] pixels wide).
 
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -31,6 +31,9 @@ use crate::mesh::{self, LoadOptions, Mesh};
 use crate::metric::LinearImage;
 use crate::raster::{self, Frame, RenderSettings, SamplePattern, Shading};
 use crate::scene::{Camera, Rig, Scene, Viewing};
+
+/// Largest image side in the contact sheets, pixels.
+pub const SHEET_SIZE: u32 = 512;
 
 /// One scene: a model and its shading.
 #[derive(Debug, Clone, Deserialize)]
@@ -347,7 +350,24 @@ pub fn run(config: &Path, log: &mut dyn FnMut(&str)) -> Result<Vec<SummaryRow>> 
             }
         }
         write_plots(&out, &spec.name, &summary)?;
-        let images: Vec<image::RgbImage> = sheet.iter().map(Frame::to_srgb8).collect();
+        // At most SHEET_SIZE pixels a side per image, so the sheets stay small enough to commit.
+        let images: Vec<image::RgbImage> = sheet
+            .iter()
+            .map(|f| {
+                let img = f.to_srgb8();
+                if img.width() > SHEET_SIZE {
+                    let h = img.height() * SHEET_SIZE / img.width();
+                    image::imageops::resize(
+                        &img,
+                        SHEET_SIZE,
+                        h,
+                        image::imageops::FilterType::Triangle,
+                    )
+                } else {
+                    img
+                }
+            })
+            .collect();
         let sheet = raster::contact_sheet(&images, images.len() as u32, 4, [255; 3]);
         crate::io::write_image(
             &out.join(format!("{}-sheet.png", spec.name)),
