@@ -19,7 +19,10 @@
 //!
 //! Each frame: keys of both queues are recomputed for the new view; then, as in the paper's
 //! `simplifyBudget`, lower the smallest-error node while over budget and raise the largest-error
-//! node while within it, until the node just raised is the next to be lowered. The result always fits the budget.
+//! node while within it, until the node just raised is lowered again. A lowering is keyed by the
+//! largest key among the nodes it forces (else the cheapest-looking lowering often re-applies the
+//! node just raised and the loop ends after one step). Budget left over when the loop ends goes to
+//! the largest-error raises that force nothing and fit. The result always fits the budget.
 
 use std::cmp::Ordering;
 use std::collections::BinaryHeap;
@@ -95,7 +98,8 @@ impl Cut {
             lower: BinaryHeap::new(),
             keys: vec![[0.0; 2]; n],
             key_frame: vec![0; n],
-            frame: 0,
+            // Frame 0 is "never keyed": the first `adapt` starts frame 2.
+            frame: 1,
             last_changes: 0,
         }
     }

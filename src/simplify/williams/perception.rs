@@ -265,13 +265,14 @@ impl ViewModel {
         (size * self.pixels_per_unit(d)) as f64
     }
 
-    /// Worst-case spatial frequency (cycles per degree), clamped to no lower than the CSF peak.
+    /// Worst-case (lowest) spatial frequency of the node's features, cycles per degree; infinite
+    /// for a feature of zero size. [`ViewModel::distance`] clamps it at the CSF peak.
     pub fn frequency(&self, d: &NodeData) -> f64 {
         let px = self.feature_pixels(d);
         if px <= 0.0 {
             return f64::INFINITY;
         }
-        (self.ppd / (2.0 * px)).max(self.csf.peak_frequency())
+        self.ppd / (2.0 * px)
     }
 
     /// The imperceptibility distance of the node, metres, and the same without the clamp of
@@ -279,15 +280,12 @@ impl ViewModel {
     pub fn distance(&self, d: &NodeData, m: &MaterialFacts) -> [f64; 2] {
         let vis = self.visibility(d);
         let c = self.contrast(d, vis, m);
-        let px = self.feature_pixels(d);
+        let f = self.frequency(d);
         match self.csf.max_visible_frequency(c) {
-            Some(ft) if px > 0.0 => {
-                let f = self.ppd / (2.0 * px);
-                [
-                    self.distance_m * ft / f.max(self.csf.peak_frequency()),
-                    self.distance_m * ft / f,
-                ]
-            }
+            Some(ft) if f.is_finite() => [
+                self.distance_m * ft / f.max(self.csf.peak_frequency()),
+                self.distance_m * ft / f,
+            ],
             _ => [0.0, 0.0],
         }
     }
