@@ -109,10 +109,13 @@ pub(crate) fn rasterize(
     // The common sample counts get a loop the compiler can unroll (1 and 4 samples).
     let edges = Edges { origin, coef, bias };
     let rect = [x0, y0, x1, y1];
-    match s {
-        1 => scan::<1>(st, id, rect, &edges, sample_off, buf),
-        4 => scan::<4>(st, id, rect, &edges, sample_off, buf),
-        _ => scan::<0>(st, id, rect, &edges, sample_off, buf),
+    // Coverage counting (a diagnostic) gets its own instance, so the render path has no
+    // per-sample branch for it.
+    match (s, buf.counts.is_some()) {
+        (1, false) => scan::<1, false>(st, id, rect, &edges, sample_off, buf),
+        (4, false) => scan::<4, false>(st, id, rect, &edges, sample_off, buf),
+        (_, false) => scan::<0, false>(st, id, rect, &edges, sample_off, buf),
+        (_, true) => scan::<0, true>(st, id, rect, &edges, sample_off, buf),
     }
 }
 
@@ -124,9 +127,10 @@ struct Edges {
     bias: [i64; 3],
 }
 
-/// The pixel loop of [`rasterize`]; `S` is the sample count, or 0 for "read it from the slice".
+/// The pixel loop of [`rasterize`]; `S` is the sample count, or 0 for "read it from the slice";
+/// `COUNT` says whether `buf.counts` is there to count coverage.
 #[inline(always)]
-fn scan<const S: usize>(
+fn scan<const S: usize, const COUNT: bool>(
     st: &SetupTri,
     id: u32,
     [x0, y0, x1, y1]: [i32; 4],
@@ -153,7 +157,7 @@ fn scan<const S: usize>(
                     continue;
                 }
                 let slot = base + k;
-                if let Some(c) = buf.counts.as_mut() {
+                if COUNT && let Some(c) = buf.counts.as_mut() {
                     c[slot] = c[slot].saturating_add(1);
                 }
                 // Unbiased values give the barycentric weights.
