@@ -1,5 +1,6 @@
 //! SVG line plots for the paper experiments (energy against evaluations, error against budget):
-//! linear axes from zero, one colour per series (pairs of solid and dashed series share one when
+//! a linear y axis from zero, a linear x axis from zero or a logarithmic one (ticks at the data's x
+//! values), one colour per series (pairs of solid and dashed series share one when
 //! any series is dashed), a legend on the right.
 
 use std::fmt::Write as _;
@@ -11,13 +12,41 @@ const COLORS: [&str; 8] = [
     "#1b9e77", "#d95f02", "#7570b3", "#e7298a", "#66a61e", "#e6ab02", "#a6761d", "#666666",
 ];
 
-/// A line plot: series of (name, points, dashed), linear axes from zero.
-pub fn line_plot(title: &str, x_label: &str, y_label: &str, series: &[Series]) -> String {
+/// A line plot: series of (name, points, dashed); `log_x` for a logarithmic x axis (positive x
+/// only).
+pub fn line_plot(
+    title: &str,
+    x_label: &str,
+    y_label: &str,
+    series: &[Series],
+    log_x: bool,
+) -> String {
     let (w, h, ml, mr, mt, mb) = (720.0, 420.0, 80.0, 220.0, 40.0, 50.0);
     let all = series.iter().flat_map(|s| s.1.iter());
     let x_max = all.clone().map(|p| p.0).fold(0.0f64, f64::max).max(1e-12) * 1.05;
-    let y_max = all.map(|p| p.1).fold(0.0f64, f64::max).max(1e-12) * 1.1;
-    let px = |x: f64| ml + x / x_max * (w - ml - mr);
+    let x_min = all
+        .clone()
+        .map(|p| p.0)
+        .filter(|&x| x > 0.0)
+        .fold(f64::INFINITY, f64::min)
+        .min(x_max / 1.05)
+        / 1.05;
+    let y_max = all.clone().map(|p| p.1).fold(0.0f64, f64::max).max(1e-12) * 1.1;
+    let px = |x: f64| {
+        let t = if log_x {
+            (x.max(x_min) / x_min).ln() / (x_max / x_min).ln()
+        } else {
+            x / x_max
+        };
+        ml + t * (w - ml - mr)
+    };
+    let mut x_ticks: Vec<f64> = if log_x {
+        all.map(|p| p.0).filter(|&x| x > 0.0).collect()
+    } else {
+        (0..=4).map(|k| x_max * k as f64 / 4.0).collect()
+    };
+    x_ticks.sort_by(f64::total_cmp);
+    x_ticks.dedup();
     let py = |y: f64| h - mb - y / y_max * (h - mt - mb);
     let mut s = String::new();
     let _ = writeln!(
@@ -26,14 +55,20 @@ pub fn line_plot(title: &str, x_label: &str, y_label: &str, series: &[Series]) -
         w - ml - mr,
         h - mt - mb
     );
-    for k in 0..=4 {
-        let (x, y) = (x_max * k as f64 / 4.0, y_max * k as f64 / 4.0);
+    for x in x_ticks {
         let _ = writeln!(
             s,
-            "<text x=\"{:.1}\" y=\"{:.1}\" text-anchor=\"middle\">{}</text><text x=\"{:.1}\" y=\"{:.1}\" text-anchor=\"end\">{:.3e}</text><line x1=\"{ml}\" x2=\"{:.1}\" y1=\"{:.1}\" y2=\"{:.1}\" stroke=\"#eee\"/>",
+            "<text x=\"{:.1}\" y=\"{:.1}\" text-anchor=\"middle\">{}</text>",
             px(x),
             h - mb + 16.0,
-            x.round(),
+            x.round()
+        );
+    }
+    for k in 0..=4 {
+        let y = y_max * k as f64 / 4.0;
+        let _ = writeln!(
+            s,
+            "<text x=\"{:.1}\" y=\"{:.1}\" text-anchor=\"end\">{:.3e}</text><line x1=\"{ml}\" x2=\"{:.1}\" y1=\"{:.1}\" y2=\"{:.1}\" stroke=\"#eee\"/>",
             ml - 4.0,
             py(y) + 4.0,
             y,

@@ -216,6 +216,7 @@ pub fn run(config: &Path, log: &mut dyn FnMut(&str)) -> Result<Vec<ResultRow>> {
             "vertices",
             "held-out d_MS",
             &series,
+            false,
         );
         crate::io::write_atomic(
             &out.join(format!("{}-energy-vs-vertices.svg", spec.name)),
@@ -228,6 +229,7 @@ pub fn run(config: &Path, log: &mut dyn FnMut(&str)) -> Result<Vec<ResultRow>> {
         "energy evaluations",
         "E / E(input)",
         &series,
+        false,
     );
     crate::io::write_atomic(&out.join("energy-vs-evals.svg"), svg.as_bytes())?;
     Ok(rows)

@@ -405,9 +405,10 @@ fn write_plots(out: &Path, scene: &str, summary: &[SummaryRow]) -> Result<()> {
         }
         panels.push(line_plot(
             &format!("{scene} — {title}"),
-            "triangle budget",
+            "triangle budget (log scale)",
             y,
             &series,
+            true,
         ));
     }
     // Stack the panels vertically in one SVG.
