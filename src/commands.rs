@@ -757,7 +757,11 @@ pub fn bench_williams(mesh: &Mesh, ratios: &[f64], views: u32) -> Result<Vec<Wil
     let start = std::time::Instant::now();
     let pre = preprocess::preprocess(&hierarchy);
     let preprocess_seconds = start.elapsed().as_secs_f64();
-    let w = Williams { hierarchy, pre };
+    let w = Williams {
+        hierarchy,
+        pre,
+        flat: false,
+    };
     let n = views.max(2);
     let orbit = (0..n)
         .map(|i| {

@@ -125,7 +125,7 @@ pub(crate) fn normal_only_seams(mesh: &Mesh) -> Option<(Mesh, bool)> {
 
 /// Give a LOD of a flat-shaded original its flat shading back: one vertex per corner with the
 /// face's normal.
-fn flatten(lod: &Mesh) -> Result<Mesh> {
+pub(crate) fn flatten(lod: &Mesh) -> Result<Mesh> {
     let p = lod.positions();
     let mut data = lod.to_data();
     data.positions = lod

@@ -72,19 +72,25 @@ pub struct Williams {
     pub hierarchy: Hierarchy,
     /// Per-node data.
     pub pre: Preprocessed,
+    /// The input was flat-shaded (split only by normals): LODs get flat shading back.
+    pub flat: bool,
 }
 
 impl Williams {
     /// Build the MT of `mesh` and preprocess it. Meshes split only by normals (flat shading) are
     /// welded first, as the other simplifiers do.
     pub fn build(mesh: &Mesh) -> Result<Williams> {
-        let input = match super::normal_only_seams(mesh) {
-            Some((welded, _)) => welded,
-            None => mesh.clone(),
+        let (input, flat) = match super::normal_only_seams(mesh) {
+            Some((welded, flat)) => (welded, flat),
+            None => (mesh.clone(), false),
         };
         let hierarchy = Hierarchy::build(&Arc::new(input))?;
         let pre = preprocess::preprocess(&hierarchy);
-        Ok(Williams { hierarchy, pre })
+        Ok(Williams {
+            hierarchy,
+            pre,
+            flat,
+        })
     }
 
     /// The evaluation model of one camera.
@@ -115,9 +121,16 @@ impl Williams {
         });
     }
 
-    /// The mesh of a cut.
+    /// The mesh of a cut (flat-shaded if the input was).
     pub fn mesh(&self, cut: &Cut) -> Result<Mesh> {
-        self.hierarchy.mesh_of(|t| cut.is_alive(&self.hierarchy, t))
+        let lod = self
+            .hierarchy
+            .mesh_of(|t| cut.is_alive(&self.hierarchy, t))?;
+        if self.flat {
+            super::flatten(&lod)
+        } else {
+            Ok(lod)
+        }
     }
 
     /// One LOD for all of `cameras`: every node keyed by its largest error over them.
@@ -354,6 +367,8 @@ mod tests {
             w.adapt(&mut cut, &cam, budget, &opts);
             let lod = w.mesh(&cut).unwrap();
             assert!(lod.triangle_count() <= budget && lod.triangle_count() + 4 >= budget);
+            // This bunny is flat-shaded (one normal per face), and so are its LODs.
+            assert_eq!(lod.vertex_count(), 3 * lod.triangle_count());
             let mut b = [0usize; 3];
             for t in lod.triangles() {
                 let [p0, p1, p2] = t.map(|v| lod.positions()[v as usize]);
