@@ -692,19 +692,12 @@ pub fn simplify_williams(job: &WilliamsJob) -> Result<Vec<SimplifyRow>> {
                     "--camera: the eye must be finite and apart from the target".into(),
                 ));
             }
-            let mut cam = Camera::frame_sphere(
+            vec![Camera::looking_at(
                 sphere,
-                *eye - target,
+                *eye,
+                target,
                 Camera::DEFAULT_FOV_Y_DEG,
-                1.0,
-                Camera::DEFAULT_MARGIN,
-            );
-            cam.eye = *eye;
-            cam.target = target;
-            let dist = eye.distance(sphere.center);
-            cam.near = (dist - sphere.radius).max(dist * 1e-3);
-            cam.far = dist + sphere.radius;
-            vec![cam]
+            )]
         }
     };
     let lod = w.static_lod(&cameras, job.goal, &opts)?;
@@ -750,18 +743,8 @@ pub struct WilliamsBenchRow {
 /// of `views` cameras around the model (slightly above it), each turned 360°/`views` from the
 /// last, for each budget ratio. Times are wall clock (reporting only).
 pub fn bench_williams(mesh: &Mesh, ratios: &[f64], views: u32) -> Result<Vec<WilliamsBenchRow>> {
-    use crate::simplify::williams::{Cut, Hierarchy, Options, Williams, preprocess};
-    let start = std::time::Instant::now();
-    let hierarchy = Hierarchy::build(&Arc::new(mesh.clone()))?;
-    let hierarchy_seconds = start.elapsed().as_secs_f64();
-    let start = std::time::Instant::now();
-    let pre = preprocess::preprocess(&hierarchy);
-    let preprocess_seconds = start.elapsed().as_secs_f64();
-    let w = Williams {
-        hierarchy,
-        pre,
-        flat: false,
-    };
+    use crate::simplify::williams::{Cut, Options, Williams};
+    let (w, [hierarchy_seconds, preprocess_seconds]) = Williams::build_timed(mesh)?;
     let n = views.max(2);
     let orbit = (0..n)
         .map(|i| {

@@ -750,7 +750,7 @@ fn run(cli: Cli) -> Result<(), Error> {
             let rows = lodeval::simplify::williams::experiment::run(&config, &mut |line| {
                 eprintln!("{line}")
             })?;
-            eprintln!("{} curves points written", rows.len());
+            eprintln!("{} curve points written", rows.len());
             Ok(())
         }
         Command::Simplify(a) if a.method == "williams" => {

@@ -75,6 +75,21 @@ impl Camera {
         }
     }
 
+    /// A perspective camera at `eye` looking at `target` (which must differ from `eye`), with its
+    /// near and far planes around `sphere` (the near plane at least 1/1000 of the distance).
+    pub fn looking_at(sphere: Sphere, eye: Vec3, target: Vec3, fov_y_deg: f32) -> Camera {
+        let dir = (eye - target).try_normalize().unwrap_or(Vec3::Z);
+        let dist = eye.distance(sphere.center);
+        Camera {
+            eye,
+            target,
+            up: up_for(dir),
+            projection: Projection::Perspective { fov_y_deg },
+            near: (dist - sphere.radius).max(dist * 1e-3),
+            far: dist + sphere.radius,
+        }
+    }
+
     /// An orthographic camera on the same axis, showing the sphere grown by `margin`.
     pub fn frame_sphere_ortho(sphere: Sphere, direction: Vec3, aspect: f32, margin: f32) -> Camera {
         let dir = direction.try_normalize().unwrap_or(Vec3::Z);

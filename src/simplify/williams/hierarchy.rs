@@ -183,25 +183,19 @@ impl Hierarchy {
         // Prerequisites: creators of removed triangles; dependents: removers of created ones.
         let nodes = pm.collapses.len() as u32;
         let (mut prerequisites, mut dependents) = (Lists::default(), Lists::default());
+        let distinct = |ts: &[u32], node_of: fn(&Tri) -> u32| {
+            let mut v: Vec<u32> = ts
+                .iter()
+                .map(|&t| node_of(&tris[t as usize]))
+                .filter(|&c| c != NONE)
+                .collect();
+            v.sort_unstable();
+            v.dedup();
+            v
+        };
         for n in 0..nodes {
-            let mut p: Vec<u32> = removed
-                .get(n)
-                .iter()
-                .map(|&t| tris[t as usize].creator)
-                .filter(|&c| c != NONE)
-                .collect();
-            p.sort_unstable();
-            p.dedup();
-            prerequisites.push(p);
-            let mut d: Vec<u32> = created
-                .get(n)
-                .iter()
-                .map(|&t| tris[t as usize].remover)
-                .filter(|&c| c != NONE)
-                .collect();
-            d.sort_unstable();
-            d.dedup();
-            dependents.push(d);
+            prerequisites.push(distinct(removed.get(n), |t| t.creator));
+            dependents.push(distinct(created.get(n), |t| t.remover));
         }
         Hierarchy {
             original: mesh.clone(),

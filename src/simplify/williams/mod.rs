@@ -80,17 +80,27 @@ impl Williams {
     /// Build the MT of `mesh` and preprocess it. Meshes split only by normals (flat shading) are
     /// welded first, as the other simplifiers do.
     pub fn build(mesh: &Mesh) -> Result<Williams> {
+        Ok(Self::build_timed(mesh)?.0)
+    }
+
+    /// [`Williams::build`], also giving the wall-clock seconds of the MT build and of the
+    /// preprocessing (for `lodeval bench williams`; reporting only).
+    pub fn build_timed(mesh: &Mesh) -> Result<(Williams, [f64; 2])> {
+        let start = std::time::Instant::now();
         let (input, flat) = match super::normal_only_seams(mesh) {
             Some((welded, flat)) => (welded, flat),
             None => (mesh.clone(), false),
         };
         let hierarchy = Hierarchy::build(&Arc::new(input))?;
+        let built = start.elapsed().as_secs_f64();
+        let start = std::time::Instant::now();
         let pre = preprocess::preprocess(&hierarchy);
-        Ok(Williams {
+        let w = Williams {
             hierarchy,
             pre,
             flat,
-        })
+        };
+        Ok((w, [built, start.elapsed().as_secs_f64()]))
     }
 
     /// The evaluation model of one camera.
