@@ -25,6 +25,8 @@
 pub mod commands;
 pub mod error;
 pub mod eval;
+#[cfg(feature = "gpu")]
+pub mod gpu;
 pub mod io;
 pub mod mesh;
 pub mod metric;

@@ -39,6 +39,8 @@ pub use frame::{Frame, NO_TRIANGLE, contact_sheet};
 pub use prepare::PreparedMesh;
 pub use region::RegionRenderer;
 pub use texture::MipTexture;
+#[cfg(feature = "gpu")]
+pub(crate) use shade::ResolvedLight;
 
 /// Shading models, by the names a config or the CLI uses.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -106,7 +108,7 @@ impl SamplePattern {
     }
 
     /// Sample offsets within the pixel, in Fx24_8 units (0..256), in sample order.
-    fn offsets(self) -> Vec<[i64; 2]> {
+    pub(crate) fn offsets(self) -> Vec<[i64; 2]> {
         let to_fx = |v: f64| (v * fixed::ONE_PIXEL as f64).round() as i64;
         match self {
             SamplePattern::Ordered(n) => {
@@ -166,7 +168,7 @@ impl RenderSettings {
     /// Largest accepted image edge, pixels.
     pub const MAX_SIZE: u32 = 16384;
 
-    fn check(&self) -> Result<()> {
+    pub(crate) fn check(&self) -> Result<()> {
         if self.width == 0
             || self.height == 0
             || self.width > Self::MAX_SIZE
@@ -233,7 +235,7 @@ pub(crate) fn rect_union(a: Option<[i32; 4]>, b: [i32; 4]) -> [i32; 4] {
 }
 
 /// Camera matrices and depth range for a frame of the given size.
-fn camera_setup(camera: &Camera, width: u32, height: u32) -> (glam::Mat4, (f32, f32, bool)) {
+pub(crate) fn camera_setup(camera: &Camera, width: u32, height: u32) -> (glam::Mat4, (f32, f32, bool)) {
     let aspect = width as f32 / height as f32;
     let mvp = camera.projection(aspect) * camera.view();
     let perspective = matches!(camera.projection, Projection::Perspective { .. });

@@ -74,6 +74,14 @@ impl MipTexture {
         MipTexture { levels }
     }
 
+    /// The levels, finest first: (width, height, texels row-major, top row first).
+    #[cfg(feature = "gpu")]
+    pub(crate) fn levels(&self) -> impl Iterator<Item = (usize, usize, &[Vec3])> {
+        self.levels
+            .iter()
+            .map(|l| (l.width, l.height, l.texels.as_slice()))
+    }
+
     /// Number of levels (1 for a 1×1 texture).
     pub fn level_count(&self) -> usize {
         self.levels.len()

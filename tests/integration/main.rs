@@ -24,6 +24,8 @@ mod cli;
 mod common;
 mod eval;
 mod fuzz;
+#[cfg(feature = "gpu")]
+mod gpu;
 mod models;
 mod optimize;
 mod oracles;

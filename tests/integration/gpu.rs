@@ -1,0 +1,169 @@
+//! The GPU mirror (feature `gpu`) against the CPU reference: frames for every shading model on
+//! real models, the metric kernels on the oracle pairs, the `--backend` switch.
+//!
+//! Without an adapter these tests print "GPU path skipped: no adapter (…)" and return, unless
+//! `LODEVAL_REQUIRE_GPU=1` (set by `.ci/run`, which installs Mesa's software Vulkan driver), in
+//! which case a missing adapter fails them: CI never passes them silently.
+
+use std::sync::Arc;
+
+use lodeval::commands::rig_cameras;
+use lodeval::gpu::{Gpu, GpuScene};
+use lodeval::mesh::{self, LoadOptions, Mesh};
+use lodeval::metric::LinearImage;
+use lodeval::metric::flip::Flip;
+use lodeval::raster::{self, Frame, NO_TRIANGLE, RenderSettings, SamplePattern, Shading};
+use lodeval::scene::{Rig, Scene};
+
+use crate::common::model;
+
+/// The device, or `None` (with the message) where there is none and none is required.
+pub fn gpu() -> Option<Arc<Gpu>> {
+    match Gpu::new() {
+        Ok(g) => {
+            eprintln!("GPU adapter: {}", g.info());
+            Some(g)
+        }
+        Err(e) if std::env::var_os("LODEVAL_REQUIRE_GPU").is_some() => {
+            panic!("LODEVAL_REQUIRE_GPU is set but: {e}")
+        }
+        Err(e) => {
+            eprintln!("{e}");
+            None
+        }
+    }
+}
+
+fn load(rel: &str) -> Arc<Mesh> {
+    Arc::new(mesh::load(&model(rel), &LoadOptions::DEFAULT).unwrap())
+}
+
+/// How far a GPU frame is from the CPU frame.
+#[derive(Debug)]
+struct Parity {
+    /// FLIP (67 ppd) between the two frames: mean and 99th percentile.
+    flip_mean: f64,
+    flip_p99: f64,
+    /// Share of pixels, outside one pixel of silhouettes, whose FLIP error exceeds 0.1.
+    differing: f64,
+    /// Share of covered pixels whose triangle id differs (anywhere, edges included).
+    ids_differing: f64,
+}
+
+/// Parity of two frames of the same camera (`near`, `far`: its depth range).
+fn parity(cpu: &Frame, gpu: &Frame, near: f32, far: f32) -> Parity {
+    let flip = Flip::new(67.02)
+        .compare(&LinearImage::from(cpu), &LinearImage::from(gpu))
+        .unwrap();
+    let (w, h) = (cpu.width() as i64, cpu.height() as i64);
+    // View distance from NDC depth (0 near .. 1 far).
+    let distance = |d: f32| near * far / (far - d * (far - near));
+    let (mut interior, mut differing, mut covered, mut ids_differing) = (0usize, 0, 0, 0);
+    for y in 0..h {
+        for x in 0..w {
+            let i = (y * w + x) as usize;
+            if cpu.triangle_ids()[i] != NO_TRIANGLE || gpu.triangle_ids()[i] != NO_TRIANGLE {
+                covered += 1;
+                ids_differing += (cpu.triangle_ids()[i] != gpu.triangle_ids()[i]) as usize;
+            }
+            if x == 0 || y == 0 || x == w - 1 || y == h - 1 || cpu.coverage()[i] < 1.0 {
+                continue;
+            }
+            // A silhouette: a neighbour not fully covered, or 2 % further or nearer.
+            let z = distance(cpu.depth()[i]);
+            let silhouette = (-1..=1).any(|dy| {
+                (-1..=1).any(|dx| {
+                    let j = ((y + dy) * w + x + dx) as usize;
+                    cpu.coverage()[j] < 1.0 || (distance(cpu.depth()[j]) - z).abs() > 0.02 * z
+                })
+            });
+            if !silhouette {
+                interior += 1;
+                differing += (flip.map.values[i] > 0.1) as usize;
+            }
+        }
+    }
+    Parity {
+        flip_mean: flip.mean,
+        flip_p99: lodeval::metric::pool::percentile(&flip.map.values, 99.0),
+        differing: differing as f64 / interior.max(1) as f64,
+        ids_differing: ids_differing as f64 / covered.max(1) as f64,
+    }
+}
+
+/// The stated parity tolerances (measured on lavapipe: FLIP mean ≤ 5e-4, p99 ≤ 4e-3, no pixel
+/// above 0.1 outside silhouettes, ≤ 0.03 % of covered pixels with another triangle id).
+fn assert_parity(what: &str, p: &Parity) {
+    eprintln!("{what}: {p:?}");
+    assert!(p.flip_mean <= 2e-3, "{what}: FLIP mean {}", p.flip_mean);
+    assert!(p.flip_p99 <= 2e-2, "{what}: FLIP p99 {}", p.flip_p99);
+    assert!(p.differing <= 1e-3, "{what}: {} of interior pixels differ", p.differing);
+    assert!(p.ids_differing <= 5e-3, "{what}: {} of triangle ids differ", p.ids_differing);
+}
+
+fn settings(w: u32, h: u32, shading: Shading, samples: SamplePattern) -> RenderSettings {
+    let mut s = RenderSettings::DEFAULT;
+    (s.width, s.height, s.shading, s.samples) = (w, h, shading, samples);
+    s
+}
+
+#[test]
+fn gpu_frames_match_the_cpu_reference_for_every_shading_model() {
+    let Some(gpu) = gpu() else { return };
+    for rel in [
+        "spot/spot_mtl.obj",
+        "barrel/barrel.glb",
+        "bunny/stanford-bunny.obj",
+        "bob/bob_tri.obj",
+    ] {
+        let scene = Scene::new(load(rel));
+        let on_gpu = GpuScene::new(gpu.clone(), &scene).unwrap();
+        let cameras = rig_cameras(scene.mesh(), &Rig::Dodecahedron, 1.0);
+        for shading in Shading::ALL {
+            for samples in [SamplePattern::Rotated(2), SamplePattern::Ordered(1)] {
+                let s = settings(192, 160, shading, samples);
+                for view in [0, 7] {
+                    let c = &cameras[view];
+                    let cpu = raster::render(&scene, c, &s).unwrap();
+                    let g = on_gpu.render(c, &s).unwrap();
+                    let what = format!("{rel} {} {samples:?} view {view}", shading.name());
+                    assert_parity(&what, &parity(&cpu, &g, c.near, c.far));
+                }
+            }
+        }
+    }
+}
+
+#[test]
+fn gpu_mirrors_sample_patterns_culling_and_is_repeatable() {
+    let Some(gpu) = gpu() else { return };
+    let scene = Scene::new(load("spot/spot_mtl.obj"));
+    let on_gpu = GpuScene::new(gpu, &scene).unwrap();
+    let c = rig_cameras(scene.mesh(), &Rig::Icosahedron, 1.0)[3];
+    for samples in [
+        SamplePattern::Ordered(2),
+        SamplePattern::Ordered(3),
+        SamplePattern::Rotated(3),
+        SamplePattern::Rotated(4),
+    ] {
+        for cull in [false, true] {
+            let mut s = settings(96, 80, Shading::Phong, samples);
+            s.cull_backfaces = cull;
+            let cpu = raster::render(&scene, &c, &s).unwrap();
+            let g = on_gpu.render(&c, &s).unwrap();
+            assert_parity(
+                &format!("spot {samples:?} cull {cull}"),
+                &parity(&cpu, &g, c.near, c.far),
+            );
+            // Coverage per pixel is a count of samples: exact.
+            let cov_differs = cpu
+                .coverage()
+                .iter()
+                .zip(g.coverage())
+                .filter(|(a, b)| a != b)
+                .count();
+            assert!(cov_differs * 200 <= cpu.coverage().len(), "{samples:?}: {cov_differs}");
+            assert_eq!(on_gpu.render(&c, &s).unwrap(), g, "repeated GPU frames differ");
+        }
+    }
+}
