@@ -25,7 +25,9 @@
 //! - GPU results are deterministic on one driver, not promised identical across drivers.
 
 mod context;
+mod metric;
 mod render;
 
-pub use context::{AdapterInfo, Gpu};
+pub use context::{AdapterInfo, Gpu, NO_ADAPTER};
+pub use metric::{GpuFlipPrepared, GpuMetrics};
 pub use render::GpuScene;

@@ -211,6 +211,20 @@ impl Flip {
         }
     }
 
+    /// The separable filters and the largest colour difference, for the GPU kernels:
+    /// (spatial taps (Y, Cx, Cz₁, Cz₂), feature taps (Gaussian, 1st, 2nd derivative), cmax).
+    #[cfg(feature = "gpu")]
+    pub(crate) fn kernels(&self) -> (Vec<[f32; 4]>, Vec<[f32; 4]>, f32) {
+        (
+            self.spatial
+                .iter()
+                .map(|(ycx, cz)| [ycx[0], ycx[1], cz[0], cz[1]])
+                .collect(),
+            self.features.iter().map(|f| [f[0], f[1], f[2], 0.0]).collect(),
+            self.cmax,
+        )
+    }
+
     /// Pixels per degree this evaluator was built for.
     pub fn ppd(&self) -> f32 {
         self.ppd

@@ -8,7 +8,7 @@ pub mod color;
 pub mod colormap;
 pub mod csf;
 pub mod flip;
-mod image;
+pub(crate) mod image;
 pub mod mse;
 pub mod pool;
 pub mod ssim;

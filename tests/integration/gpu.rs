@@ -167,3 +167,52 @@ fn gpu_mirrors_sample_patterns_culling_and_is_repeatable() {
         }
     }
 }
+
+#[test]
+fn gpu_metric_kernels_match_the_cpu_on_the_oracle_pairs() {
+    // Tolerance from the issue: GPU metric vs CPU metric within 1e-4 on the oracle pairs.
+    let Some(gpu) = gpu() else { return };
+    let metrics = lodeval::gpu::GpuMetrics::new(gpu).unwrap();
+    let text =
+        std::fs::read_to_string(crate::common::root().join("reference/oracles/values.json"))
+            .unwrap();
+    let v: serde_json::Value = serde_json::from_str(&text).unwrap();
+    let pairs = v["flip"].as_array().unwrap();
+    assert!(pairs.len() >= 10);
+    let mut worst = [0.0f64; 3];
+    for p in pairs {
+        let name = p["name"].as_str().unwrap();
+        let load = |k: &str| {
+            LinearImage::load(&crate::common::root().join(p[k].as_str().unwrap())).unwrap()
+        };
+        let (a, b) = (load("reference"), load("test"));
+        let flip = Flip::new(p["ppd"].as_f64().unwrap() as f32);
+        let cpu = flip.compare(&a, &b).unwrap();
+        let g = metrics.flip(&flip, &a, &b).unwrap();
+        let pixel = cpu
+            .map
+            .values
+            .iter()
+            .zip(&g.map.values)
+            .map(|(x, y)| (x - y).abs() as f64)
+            .fold(0.0, f64::max);
+        let cpu_mse = lodeval::metric::mse::mse(&a, &b).unwrap();
+        let gpu_mse = metrics.mse(&a, &b).unwrap();
+        eprintln!(
+            "{name}: FLIP mean CPU {:.7} GPU {:.7}, worst pixel {pixel:.2e}; MSE CPU {:.9} GPU {:.9}",
+            cpu.mean, g.mean, cpu_mse.mse, gpu_mse.mse
+        );
+        let d = [
+            (cpu.mean - g.mean).abs(),
+            pixel,
+            (cpu_mse.mse - gpu_mse.mse).abs(),
+        ];
+        (0..3).for_each(|k| worst[k] = worst[k].max(d[k]));
+        assert!(d[0] <= 1e-4, "{name}: FLIP mean {} vs {}", cpu.mean, g.mean);
+        assert!(d[2] <= 1e-4 * cpu_mse.mse.max(1e-3), "{name}: MSE {cpu_mse:?} vs {gpu_mse:?}");
+    }
+    eprintln!(
+        "worst: FLIP mean {:.2e}, FLIP pixel {:.2e}, MSE {:.2e}",
+        worst[0], worst[1], worst[2]
+    );
+}
