@@ -15,6 +15,7 @@ fn main() {
         samples: vec![1, 4],
         shading: Shading::Gouraud,
         export: None,
+        backend: lodeval::backend::Backend::Cpu,
     };
     let rows = bench_raster(&job).expect("benchmark runs");
     print!("{}", lodeval::commands::raster_bench_table(&rows));

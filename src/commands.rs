@@ -47,6 +47,8 @@ pub struct RenderJob {
     pub views: ViewSelection,
     /// Also write linear float EXR files beside each PNG.
     pub exr: bool,
+    /// Where to render.
+    pub backend: crate::backend::Backend,
 }
 
 /// Cameras for every view of `rig`, each framing the mesh's bounding sphere.
@@ -82,6 +84,8 @@ pub fn render(job: &RenderJob) -> Result<Vec<PathBuf>> {
     let scene = Scene::new(mesh.clone());
     let aspect = job.settings.width as f32 / job.settings.height as f32;
     let cameras = rig_cameras(&mesh, &job.rig, aspect);
+    let engine = crate::backend::Engine::new(job.backend)?;
+    let renderer = engine.scene(&scene)?;
     let mut written = Vec::new();
     match &job.views {
         ViewSelection::One { view, out } => {
@@ -91,28 +95,20 @@ pub fn render(job: &RenderJob) -> Result<Vec<PathBuf>> {
                     cameras.len() - 1
                 ))
             })?;
-            write_frame(
-                out,
-                &raster::render(&scene, camera, &job.settings)?,
-                job.exr,
-            )?;
+            write_frame(out, &renderer.render(camera, &job.settings)?, job.exr)?;
             written.push(out.clone());
         }
         ViewSelection::All { out_dir } => {
             for (k, camera) in cameras.iter().enumerate() {
                 let out = out_dir.join(format!("view-{k:02}.png"));
-                write_frame(
-                    &out,
-                    &raster::render(&scene, camera, &job.settings)?,
-                    job.exr,
-                )?;
+                write_frame(&out, &renderer.render(camera, &job.settings)?, job.exr)?;
                 written.push(out);
             }
         }
         ViewSelection::Sheet { out } => {
             let frames = cameras
                 .iter()
-                .map(|c| raster::render(&scene, c, &job.settings).map(|f| f.to_srgb8()))
+                .map(|c| renderer.render(c, &job.settings).map(|f| f.to_srgb8()))
                 .collect::<Result<Vec<_>>>()?;
             let columns = (frames.len() as f32).sqrt().ceil() as u32;
             let sheet = raster::contact_sheet(&frames, columns, 4, [32, 32, 32]);
@@ -141,6 +137,8 @@ pub struct RasterBench {
     /// Also write the scene (mesh and per-view matrices) here, for rendering the identical scene
     /// with another renderer (`benches/llvmpipe_raster.py`).
     pub export: Option<PathBuf>,
+    /// Where the frames are rendered (the region re-render is CPU-only and is timed on the CPU).
+    pub backend: crate::backend::Backend,
 }
 
 /// One line of the benchmark table.
@@ -165,6 +163,8 @@ pub struct RasterBenchRow {
     /// Mean microseconds to re-render one 16×16-pixel rectangle of a kept frame
     /// ([`raster::RegionRenderer::render_rect`]), over 256 rectangles across the object.
     pub region_16_us: f64,
+    /// The renderer timed (`cpu` or `gpu: ADAPTER …`).
+    pub backend: String,
 }
 
 /// Render a procedural torus from every view and time it. Timing is for reporting only: nothing
@@ -185,6 +185,8 @@ pub fn bench_raster(b: &RasterBench) -> Result<Vec<RasterBenchRow>> {
             false,
         )?;
     }
+    let engine = crate::backend::Engine::new(b.backend)?;
+    let timed = engine.scene(&scene)?;
     let mut rows = Vec::new();
     for &samples in &b.samples {
         let n = (samples as f64).sqrt().round() as u32;
@@ -194,10 +196,10 @@ pub fn bench_raster(b: &RasterBench) -> Result<Vec<RasterBenchRow>> {
         settings.shading = b.shading;
         settings.samples = raster::SamplePattern::Rotated(n);
         // Warm-up frame (page faults, allocator), not timed.
-        raster::render(&scene, &cameras[0], &settings)?;
+        timed.render(&cameras[0], &settings)?;
         let start = std::time::Instant::now();
         for c in &cameras {
-            std::hint::black_box(raster::render(&scene, c, &settings)?);
+            std::hint::black_box(timed.render(c, &settings)?);
         }
         let secs = start.elapsed().as_secs_f64() / cameras.len() as f64;
         // Region re-render: 16×16 rectangles on a 16×16 grid over the middle of the image.
@@ -220,6 +222,7 @@ pub fn bench_raster(b: &RasterBench) -> Result<Vec<RasterBenchRow>> {
             ms_per_frame: secs * 1e3,
             frames_per_s: 1.0 / secs,
             mtri_per_s: mesh.triangle_count() as f64 / secs / 1e6,
+            backend: engine.describe(),
         });
     }
     Ok(rows)
@@ -228,11 +231,11 @@ pub fn bench_raster(b: &RasterBench) -> Result<Vec<RasterBenchRow>> {
 /// The rows of `lodeval bench raster` as a Markdown table.
 pub fn raster_bench_table(rows: &[RasterBenchRow]) -> String {
     let mut text = String::from(
-        "| triangles | size | samples | views | threads | ms/frame | frames/s | Mtri/s | 16×16 region µs |\n|---|---|---|---|---|---|---|---|---|\n",
+        "| triangles | size | samples | views | threads | ms/frame | frames/s | Mtri/s | 16×16 region µs (CPU) | backend |\n|---|---|---|---|---|---|---|---|---|---|\n",
     );
     for r in rows {
         text.push_str(&format!(
-            "| {} | {} | {} | {} | {} | {:.1} | {:.2} | {:.1} | {:.0} |\n",
+            "| {} | {} | {} | {} | {} | {:.1} | {:.2} | {:.1} | {:.0} | {} |\n",
             r.triangles,
             r.size,
             r.samples,
@@ -241,7 +244,8 @@ pub fn raster_bench_table(rows: &[RasterBenchRow]) -> String {
             r.ms_per_frame,
             r.frames_per_s,
             r.mtri_per_s,
-            r.region_16_us
+            r.region_16_us,
+            r.backend
         ));
     }
     text
@@ -359,6 +363,8 @@ pub struct DiffResult {
     /// Why the value is missing, when a metric of `--metric all` does not apply to these images.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub note: Option<String>,
+    /// Where the metric ran: `cpu`, or `gpu: ADAPTER …` for FLIP, MSE and PSNR on the GPU.
+    pub backend: String,
 }
 
 /// Compare two image files with the given metrics; writes magma heat maps if `map` is given
@@ -366,6 +372,7 @@ pub struct DiffResult {
 /// `lenient`, a metric that does not apply to images of this size (SSIM below 11×11, MS-SSIM
 /// below 176×176) is reported without a value and with a note instead of failing the command.
 pub fn diff(
+    engine: &crate::backend::Engine,
     reference: &Path,
     test: &Path,
     metrics: &[DiffMetric],
@@ -373,7 +380,7 @@ pub fn diff(
     map: Option<&Path>,
     lenient: bool,
 ) -> Result<Vec<DiffResult>> {
-    use crate::metric::{LinearImage, colormap, flip::Flip, mse, pool, ssim};
+    use crate::metric::{LinearImage, colormap, flip::Flip, pool, ssim};
     let (a, b) = (LinearImage::load(reference)?, LinearImage::load(test)?);
     if (a.width(), a.height()) != (b.width(), b.height()) {
         return Err(Error::input(
@@ -417,11 +424,15 @@ pub fn diff(
             map: None,
             note: None,
             jnd: None,
+            backend: match metric {
+                DiffMetric::Flip | DiffMetric::Mse | DiffMetric::Psnr => engine.describe(),
+                _ => crate::backend::CPU_RENDERER.to_string(),
+            },
         };
         let mut compute = || -> Result<()> {
             match metric {
                 DiffMetric::Flip => {
-                    let s = Flip::new(ppd as f32).compare(&a, &b)?;
+                    let s = engine.flip(&Flip::new(ppd as f32), &a, &b)?;
                     let v = &s.map.values;
                     let mut p = std::collections::BTreeMap::new();
                     for q in [25.0, 50.0, 75.0, 95.0, 99.0] {
@@ -470,9 +481,9 @@ pub fn diff(
                     r.value = Some(ssim::ms_ssim(&a, &b, ssim::SsimInput::SrgbLuma)?)
                 }
                 DiffMetric::Psnr => {
-                    r.value = Some(mse::mse(&a, &b)?.psnr_db).filter(|v| v.is_finite())
+                    r.value = Some(engine.mse(&a, &b)?.psnr_db).filter(|v| v.is_finite())
                 }
-                DiffMetric::Mse => r.value = Some(mse::mse(&a, &b)?.mse),
+                DiffMetric::Mse => r.value = Some(engine.mse(&a, &b)?.mse),
                 DiffMetric::Vdp => {
                     let s =
                         crate::metric::vdp::Vdp::new(viewing, crate::metric::vdp::Display::DEFAULT)

@@ -22,6 +22,7 @@
 
 #![warn(missing_docs, missing_debug_implementations)]
 
+pub mod backend;
 pub mod commands;
 pub mod error;
 pub mod eval;

@@ -105,14 +105,41 @@ struct RenderArgs {
     /// Also write linear float EXR beside each PNG.
     #[arg(long)]
     exr: bool,
+    /// Renderer: cpu (the reference), gpu (the wgpu mirror; needs the `gpu` feature and an
+    /// adapter) or auto (gpu when available).
+    #[arg(long, value_enum, default_value_t = BackendArg::Cpu)]
+    backend: BackendArg,
     #[command(flatten)]
     load: LoadArgs,
+}
+
+#[derive(Copy, Clone, Debug, ValueEnum)]
+enum BackendArg {
+    /// The CPU reference rasterizer and metrics.
+    Cpu,
+    /// The wgpu mirror (cargo feature `gpu`).
+    Gpu,
+    /// The GPU when built and an adapter exists, else the CPU.
+    Auto,
+}
+
+impl From<BackendArg> for lodeval::backend::Backend {
+    fn from(b: BackendArg) -> Self {
+        match b {
+            BackendArg::Cpu => Self::Cpu,
+            BackendArg::Gpu => Self::Gpu,
+            BackendArg::Auto => Self::Auto,
+        }
+    }
 }
 
 #[derive(Args, Debug)]
 struct DiffArgs {
     /// Reference image (PNG/JPEG: sRGB; EXR: linear).
     reference: PathBuf,
+    /// Where FLIP, MSE and PSNR run: cpu, gpu (compute kernels) or auto.
+    #[arg(long, value_enum, default_value_t = BackendArg::Cpu)]
+    backend: BackendArg,
     /// Test image, same size.
     test: PathBuf,
     /// Metric: flip, ssim, msssim, psnr, mse, vdp or all.
@@ -177,6 +204,9 @@ struct BenchArgs {
     /// Also export the benchmark scene to this folder (for benches/llvmpipe_raster.py).
     #[arg(long)]
     export: Option<PathBuf>,
+    /// Renderer to time: cpu, gpu or auto.
+    #[arg(long, value_enum, default_value_t = BackendArg::Cpu)]
+    backend: BackendArg,
 }
 
 #[derive(Copy, Clone, Debug, ValueEnum)]
@@ -239,6 +269,7 @@ impl RenderArgs {
             rig,
             views,
             exr: self.exr,
+            backend: self.backend.into(),
         })
     }
 }
@@ -272,6 +303,9 @@ struct EvalArgs {
     /// CI_NODE_INDEX/CI_NODE_TOTAL, JOB_COMPLETION_INDEX with LODEVAL_SHARD_COUNT).
     #[arg(long, value_name = "INDEX/COUNT")]
     shard: Option<String>,
+    /// Renderer and FLIP/MSE kernels: cpu, gpu or auto (recorded in the CSVs and the report).
+    #[arg(long, value_enum, default_value_t = BackendArg::Cpu)]
+    backend: BackendArg,
 }
 
 #[derive(Args, Debug)]
@@ -512,7 +546,9 @@ fn run(cli: Cli) -> Result<(), Error> {
             };
             // With `all`, metrics that do not apply to this image size report a note instead.
             let lenient = a.metric == "all";
+            let engine = lodeval::backend::Engine::new(a.backend.into())?;
             let results = lodeval::commands::diff(
+                &engine,
                 &a.reference,
                 &a.test,
                 &metrics,
@@ -653,6 +689,7 @@ fn run(cli: Cli) -> Result<(), Error> {
                 samples: a.samples,
                 shading,
                 export: a.export,
+                backend: a.backend.into(),
             };
             let rows = lodeval::commands::bench_raster(&job)?;
             let rss = lodeval::commands::peak_rss_mib().unwrap_or(f64::NAN);
@@ -675,6 +712,7 @@ fn run(cli: Cli) -> Result<(), Error> {
                 out: a.out,
                 shard,
                 progress: !cli.quiet && std::io::stderr().is_terminal(),
+                backend: a.backend.into(),
             };
             let outcome = lodeval::eval::eval(&a.config, &options)?;
             gate_result(&outcome)

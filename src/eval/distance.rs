@@ -233,6 +233,7 @@ pub fn search(
                 .map(|e| round7(e * job.meters_per_unit * display.k / d_m)),
             diameter_px: round7(display.diameter_px(r_m, d_m)),
             resolved,
+            renderer: crate::backend::CPU_RENDERER.to_string(),
         });
     }
     Ok(rows)

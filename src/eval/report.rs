@@ -39,6 +39,15 @@ pub fn render(plan: &Plan, results: &Results, failures: &[Failure]) -> String {
         CSS,
         esc(&title)
     );
+    let mut renderers: Vec<&str> = results.rows.iter().map(|r| r.renderer.as_str()).collect();
+    renderers.dedup();
+    renderers.sort_unstable();
+    renderers.dedup();
+    let _ = writeln!(
+        h,
+        "<p class=\"renderer\">Rendered on: {}</p>",
+        esc(&renderers.join("; "))
+    );
     let cases = results.lods.len();
     let failing: std::collections::BTreeSet<(&str, &str)> = failures
         .iter()

@@ -40,6 +40,8 @@ pub struct RunOptions {
     pub shard: Shard,
     /// Draw a progress bar (on a terminal, not quiet).
     pub progress: bool,
+    /// Where frames are rendered (`--backend`); default the CPU reference.
+    pub backend: crate::backend::Backend,
 }
 
 /// A finished (sharded) run.
@@ -75,6 +77,8 @@ pub fn run(plan: Plan, options: &RunOptions) -> Result<RunOutput> {
     let viewing = cfg.viewing.viewing();
     let scorer = Scorer::new(&cfg.metrics, &viewing, cfg.flip_pixel_threshold.0);
     let settings = cfg.render.settings();
+    let engine = crate::backend::Engine::new(options.backend)?;
+    let renderer = engine.describe();
     let mut results = Results::default();
     let cases: usize = plan
         .assets
@@ -118,17 +122,23 @@ pub fn run(plan: Plan, options: &RunOptions) -> Result<RunOutput> {
             })
             .collect::<Vec<_>>();
         let cameras = crate::commands::rig_cameras(&original, &cfg.render.rig.0, 1.0);
+        let reference_renderer = engine.scene(&reference)?;
+        let lod_renderers = lods
+            .iter()
+            .map(|l| engine.scene(&l.scene))
+            .collect::<Result<Vec<_>>>()?;
         let mut sheets: Vec<SheetViews> = vec![Vec::new(); lods.len()];
         for (v, camera) in cameras.iter().enumerate() {
-            let frame = raster::render(&reference, camera, &settings)?;
+            let frame = reference_renderer.render(camera, &settings)?;
             let ref_thumb = thumbnail(&frame.to_srgb8());
             let prepared = scorer.prepare(LinearImage::from(&frame));
             // The LODs of one view are independent: render and score them in parallel, then
             // record them in LOD order (outputs never depend on which finished first).
             let per_lod = lods
                 .par_iter()
-                .map(|lod| -> Result<_> {
-                    let test_frame = raster::render(&lod.scene, camera, &settings)?;
+                .zip(&lod_renderers)
+                .map(|(lod, lod_renderer)| -> Result<_> {
+                    let test_frame = lod_renderer.render(camera, &settings)?;
                     let scored = scorer.score(&prepared, &LinearImage::from(&test_frame))?;
                     if cfg.images.heatmaps == HeatmapChoice::All {
                         for (metric, map) in &scored.maps {
@@ -156,6 +166,7 @@ pub fn run(plan: Plan, options: &RunOptions) -> Result<RunOutput> {
                         view: v,
                         metric: metric.to_string(),
                         value,
+                        renderer: renderer.clone(),
                     });
                 }
                 if let Some(t) = thumbs {
@@ -169,8 +180,8 @@ pub fn run(plan: Plan, options: &RunOptions) -> Result<RunOutput> {
                 && let Some(&worst) = order.first()
             {
                 // Re-render the worst view only, for its heat maps.
-                let a = LinearImage::from(&raster::render(&reference, &cameras[worst], &settings)?);
-                let b = LinearImage::from(&raster::render(&lod.scene, &cameras[worst], &settings)?);
+                let a = LinearImage::from(&reference_renderer.render(&cameras[worst], &settings)?);
+                let b = LinearImage::from(&lod_renderers[k].render(&cameras[worst], &settings)?);
                 let scored = scorer.score(&scorer.prepare(a), &b)?;
                 for (metric, map) in &scored.maps {
                     write_heat_map(&out_dir, &asset.name, &lod.name, worst, metric, map)?;

@@ -34,6 +34,10 @@ pub struct MetricRow {
     pub metric: String,
     /// Its value.
     pub value: f64,
+    /// What rendered the pair: `cpu`, or `gpu: ADAPTER (DRIVER, API, TYPE)` (scores are computed
+    /// on the CPU either way).
+    #[serde(default)]
+    pub renderer: String,
 }
 
 /// What is known about one LOD besides its scores.
@@ -96,6 +100,9 @@ pub struct DistanceRow {
     /// probe (4 px; the true distance is larger), or invisible up to `max_diameter_px` (the LOD may
     /// also be imperceptible nearer).
     pub resolved: bool,
+    /// What rendered the search's frames (always `cpu`: the search runs on the reference renderer).
+    #[serde(default)]
+    pub renderer: String,
 }
 
 /// One line of `summary.csv`.
@@ -119,6 +126,9 @@ pub struct SummaryRow {
     pub max: f64,
     /// The view with the worst value.
     pub worst_view: usize,
+    /// What rendered the views (as `metrics.csv`).
+    #[serde(default)]
+    pub renderer: String,
 }
 
 /// Everything a run (or a merge of shards) produced.
@@ -206,16 +216,21 @@ impl Results {
     /// Per (asset, LOD, metric) statistics over views, in row order.
     pub fn summary(&self) -> Vec<SummaryRow> {
         let mut out: Vec<SummaryRow> = Vec::new();
-        type Key = (String, String, String);
+        type Key = (String, String, String, String);
         let mut groups: Vec<(Key, Vec<(usize, f64)>)> = Vec::new();
         for r in &self.rows {
-            let key = (r.asset.clone(), r.lod.clone(), r.metric.clone());
+            let key = (
+                r.asset.clone(),
+                r.lod.clone(),
+                r.metric.clone(),
+                r.renderer.clone(),
+            );
             match groups.iter_mut().find(|(k, _)| *k == key) {
                 Some((_, v)) => v.push((r.view, r.value)),
                 None => groups.push((key, vec![(r.view, r.value)])),
             }
         }
-        for ((asset, lod, metric), values) in groups {
+        for ((asset, lod, metric, renderer), values) in groups {
             let info = self.lods.iter().find(|l| l.asset == asset && l.lod == lod);
             let (triangles, ratio) = info.map_or((0, 0.0), |l| {
                 (
@@ -236,6 +251,7 @@ impl Results {
                 p95: round7(percentile(&vals, 95.0)),
                 max: vals.iter().copied().fold(f64::NEG_INFINITY, f64::max),
                 worst_view,
+                renderer,
             });
         }
         out
@@ -335,8 +351,15 @@ pub trait Columns {
 }
 
 impl Columns for MetricRow {
-    const COLUMNS: &'static [&'static str] =
-        &["asset", "lod", "triangles", "view", "metric", "value"];
+    const COLUMNS: &'static [&'static str] = &[
+        "asset",
+        "lod",
+        "triangles",
+        "view",
+        "metric",
+        "value",
+        "renderer",
+    ];
 }
 
 impl Columns for SummaryRow {
@@ -350,6 +373,7 @@ impl Columns for SummaryRow {
         "p95",
         "max",
         "worst_view",
+        "renderer",
     ];
 }
 
@@ -366,6 +390,7 @@ impl Columns for DistanceRow {
         "pixel_error",
         "diameter_px",
         "resolved",
+        "renderer",
     ];
 }
 
@@ -437,6 +462,7 @@ mod tests {
             view,
             metric: metric.into(),
             value,
+            renderer: "cpu".into(),
         }
     }
 
@@ -468,7 +494,7 @@ mod tests {
         assert_eq!(back.rows, r.rows);
         let text = std::fs::read_to_string(dir.path().join("metrics.csv")).unwrap();
         assert!(
-            text.starts_with("asset,lod,triangles,view,metric,value\n"),
+            text.starts_with("asset,lod,triangles,view,metric,value,renderer\n"),
             "{text}"
         );
         let d = std::fs::read_to_string(dir.path().join("distances.csv")).unwrap();
@@ -520,6 +546,7 @@ mod tests {
             pixel_error: None,
             diameter_px: 1.0,
             resolved: true,
+            renderer: "cpu".into(),
         });
     }
 }

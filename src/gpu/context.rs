@@ -181,7 +181,7 @@ impl Gpu {
             s.slice(..).map_async(wgpu::MapMode::Read, |_| {});
         }
         self.wait()?;
-        Ok(staging
+        staging
             .iter()
             .map(|s| {
                 let bytes = s
@@ -192,7 +192,7 @@ impl Gpu {
                 s.unmap();
                 Ok(bytes)
             })
-            .collect::<Result<Vec<_>>>()?)
+            .collect::<Result<Vec<_>>>()
     }
 
     /// A compute pipeline from WGSL source with entry point `main` and an inferred layout.

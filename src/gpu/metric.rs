@@ -60,10 +60,8 @@ impl GpuMetrics {
         gpu.clone().checked("compiling the metric kernels", || {
             Ok(GpuMetrics {
                 mse: gpu.compute_pipeline("mse.wgsl", include_str!("shaders/mse.wgsl")),
-                flip_color: gpu.compute_pipeline(
-                    "flip_color.wgsl",
-                    include_str!("shaders/flip_color.wgsl"),
-                ),
+                flip_color: gpu
+                    .compute_pipeline("flip_color.wgsl", include_str!("shaders/flip_color.wgsl")),
                 flip_x: gpu.compute_pipeline(
                     "flip_filter_x.wgsl",
                     include_str!("shaders/flip_filter_x.wgsl"),
@@ -253,7 +251,12 @@ impl GpuMetrics {
     }
 
     /// ꟻLIP of two images, as [`Flip::compare`].
-    pub fn flip(&self, flip: &Flip, reference: &LinearImage, test: &LinearImage) -> Result<FlipScore> {
+    pub fn flip(
+        &self,
+        flip: &Flip,
+        reference: &LinearImage,
+        test: &LinearImage,
+    ) -> Result<FlipScore> {
         crate::metric::image::same_size(reference, test)?;
         let a = self.flip_prepare(flip, reference)?;
         let b = self.flip_prepare(flip, test)?;

@@ -333,7 +333,8 @@ impl GpuScene {
                 sample_count: 1,
                 dimension: wgpu::TextureDimension::D2,
                 format,
-                usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
+                usage: wgpu::TextureUsages::RENDER_ATTACHMENT
+                    | wgpu::TextureUsages::TEXTURE_BINDING,
                 view_formats: &[],
             })
         };
@@ -365,12 +366,16 @@ impl GpuScene {
             let bind = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
                 label: Some("visibility"),
                 layout: &visibility.get_bind_group_layout(0),
-                entries: &[(0, &mvp), (1, &self.vertices), (2, &self.tris), (3, &jitter)].map(
-                    |(binding, b)| wgpu::BindGroupEntry {
-                        binding,
-                        resource: b.as_entire_binding(),
-                    },
-                ),
+                entries: &[
+                    (0, &mvp),
+                    (1, &self.vertices),
+                    (2, &self.tris),
+                    (3, &jitter),
+                ]
+                .map(|(binding, b)| wgpu::BindGroupEntry {
+                    binding,
+                    resource: b.as_entire_binding(),
+                }),
             });
             let (id_view, depth_view) = (layer(&ids, k as u32), layer(&depth, k as u32));
             let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
@@ -441,7 +446,10 @@ impl GpuScene {
         Ok(Frame {
             width: w,
             height: h,
-            color: px[..n].iter().map(|p| Vec3::new(p[0], p[1], p[2])).collect(),
+            color: px[..n]
+                .iter()
+                .map(|p| Vec3::new(p[0], p[1], p[2]))
+                .collect(),
             depth: aux[..n].iter().map(|a| f32::from_bits(a[0])).collect(),
             coverage: px[..n].iter().map(|p| p[3]).collect(),
             triangle: aux[..n].iter().map(|a| a[1]).collect(),

@@ -220,7 +220,10 @@ impl Flip {
                 .iter()
                 .map(|(ycx, cz)| [ycx[0], ycx[1], cz[0], cz[1]])
                 .collect(),
-            self.features.iter().map(|f| [f[0], f[1], f[2], 0.0]).collect(),
+            self.features
+                .iter()
+                .map(|f| [f[0], f[1], f[2], 0.0])
+                .collect(),
             self.cmax,
         )
     }

@@ -38,9 +38,9 @@ use crate::scene::{Camera, Projection, Scene};
 pub use frame::{Frame, NO_TRIANGLE, contact_sheet};
 pub use prepare::PreparedMesh;
 pub use region::RegionRenderer;
-pub use texture::MipTexture;
 #[cfg(feature = "gpu")]
 pub(crate) use shade::ResolvedLight;
+pub use texture::MipTexture;
 
 /// Shading models, by the names a config or the CLI uses.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -235,7 +235,11 @@ pub(crate) fn rect_union(a: Option<[i32; 4]>, b: [i32; 4]) -> [i32; 4] {
 }
 
 /// Camera matrices and depth range for a frame of the given size.
-pub(crate) fn camera_setup(camera: &Camera, width: u32, height: u32) -> (glam::Mat4, (f32, f32, bool)) {
+pub(crate) fn camera_setup(
+    camera: &Camera,
+    width: u32,
+    height: u32,
+) -> (glam::Mat4, (f32, f32, bool)) {
     let aspect = width as f32 / height as f32;
     let mvp = camera.projection(aspect) * camera.view();
     let perspective = matches!(camera.projection, Projection::Perspective { .. });

@@ -97,8 +97,16 @@ fn assert_parity(what: &str, p: &Parity) {
     eprintln!("{what}: {p:?}");
     assert!(p.flip_mean <= 2e-3, "{what}: FLIP mean {}", p.flip_mean);
     assert!(p.flip_p99 <= 2e-2, "{what}: FLIP p99 {}", p.flip_p99);
-    assert!(p.differing <= 1e-3, "{what}: {} of interior pixels differ", p.differing);
-    assert!(p.ids_differing <= 5e-3, "{what}: {} of triangle ids differ", p.ids_differing);
+    assert!(
+        p.differing <= 1e-3,
+        "{what}: {} of interior pixels differ",
+        p.differing
+    );
+    assert!(
+        p.ids_differing <= 5e-3,
+        "{what}: {} of triangle ids differ",
+        p.ids_differing
+    );
 }
 
 fn settings(w: u32, h: u32, shading: Shading, samples: SamplePattern) -> RenderSettings {
@@ -162,8 +170,15 @@ fn gpu_mirrors_sample_patterns_culling_and_is_repeatable() {
                 .zip(g.coverage())
                 .filter(|(a, b)| a != b)
                 .count();
-            assert!(cov_differs * 200 <= cpu.coverage().len(), "{samples:?}: {cov_differs}");
-            assert_eq!(on_gpu.render(&c, &s).unwrap(), g, "repeated GPU frames differ");
+            assert!(
+                cov_differs * 200 <= cpu.coverage().len(),
+                "{samples:?}: {cov_differs}"
+            );
+            assert_eq!(
+                on_gpu.render(&c, &s).unwrap(),
+                g,
+                "repeated GPU frames differ"
+            );
         }
     }
 }
@@ -173,9 +188,8 @@ fn gpu_metric_kernels_match_the_cpu_on_the_oracle_pairs() {
     // Tolerance from the issue: GPU metric vs CPU metric within 1e-4 on the oracle pairs.
     let Some(gpu) = gpu() else { return };
     let metrics = lodeval::gpu::GpuMetrics::new(gpu).unwrap();
-    let text =
-        std::fs::read_to_string(crate::common::root().join("reference/oracles/values.json"))
-            .unwrap();
+    let text = std::fs::read_to_string(crate::common::root().join("reference/oracles/values.json"))
+        .unwrap();
     let v: serde_json::Value = serde_json::from_str(&text).unwrap();
     let pairs = v["flip"].as_array().unwrap();
     assert!(pairs.len() >= 10);
@@ -209,10 +223,102 @@ fn gpu_metric_kernels_match_the_cpu_on_the_oracle_pairs() {
         ];
         (0..3).for_each(|k| worst[k] = worst[k].max(d[k]));
         assert!(d[0] <= 1e-4, "{name}: FLIP mean {} vs {}", cpu.mean, g.mean);
-        assert!(d[2] <= 1e-4 * cpu_mse.mse.max(1e-3), "{name}: MSE {cpu_mse:?} vs {gpu_mse:?}");
+        assert!(
+            d[2] <= 1e-4 * cpu_mse.mse.max(1e-3),
+            "{name}: MSE {cpu_mse:?} vs {gpu_mse:?}"
+        );
     }
     eprintln!(
         "worst: FLIP mean {:.2e}, FLIP pixel {:.2e}, MSE {:.2e}",
         worst[0], worst[1], worst[2]
     );
+}
+
+#[test]
+fn backend_flag_on_render_diff_and_eval() {
+    use crate::common::lodeval;
+    if gpu().is_none() {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let spot = model("spot/spot_mtl.obj");
+    let png = |b: &str| dir.path().join(format!("spot-{b}.png"));
+    for b in ["cpu", "gpu", "auto"] {
+        let r = lodeval([
+            "render".as_ref(),
+            spot.as_os_str(),
+            "-o".as_ref(),
+            png(b).as_os_str(),
+            "--size".as_ref(),
+            "128".as_ref(),
+            "--backend".as_ref(),
+            b.as_ref(),
+        ]);
+        assert_eq!(r.code, 0, "{b}: {}", r.stderr);
+    }
+    // The GPU render is FLIP-close to the CPU one, and the GPU FLIP kernel agrees with the CPU's.
+    let diff = |b: &str| {
+        let r = lodeval([
+            "diff".as_ref(),
+            png("cpu").as_os_str(),
+            png("gpu").as_os_str(),
+            "--json".as_ref(),
+            "--backend".as_ref(),
+            b.as_ref(),
+        ]);
+        assert_eq!(r.code, 0, "{}", r.stderr);
+        let v: serde_json::Value = serde_json::from_str(&r.stdout).unwrap();
+        (
+            v[0]["value"].as_f64().unwrap(),
+            v[0]["backend"].as_str().unwrap().to_string(),
+        )
+    };
+    let (cpu, cpu_backend) = diff("cpu");
+    let (on_gpu, gpu_backend) = diff("gpu");
+    eprintln!("FLIP(cpu render, gpu render) = {cpu} (CPU kernel), {on_gpu} (GPU kernel)");
+    assert!(
+        cpu < 2e-3 && (cpu - on_gpu).abs() <= 1e-4,
+        "{cpu} vs {on_gpu}"
+    );
+    assert_eq!(cpu_backend, "cpu");
+    assert!(gpu_backend.starts_with("gpu: "), "{gpu_backend}");
+    // eval records the adapter in every CSV row and in the report.
+    let config = dir.path().join("tiny.toml");
+    std::fs::write(
+        &config,
+        format!(
+            "out = \"out\"\nmetrics = [\"flip\"]\n[render]\nsize = 64\nrig = \"icosahedron\"\n\
+             [[asset]]\nname = \"spot\"\nmesh = {:?}\ngenerate = {{ method = \"meshopt\", ratios = [0.25] }}\n",
+            spot.to_str().unwrap()
+        ),
+    )
+    .unwrap();
+    let r = lodeval([
+        "eval".as_ref(),
+        config.as_os_str(),
+        "--backend".as_ref(),
+        "gpu".as_ref(),
+    ]);
+    assert_eq!(r.code, 0, "{}", r.stderr);
+    let metrics = std::fs::read_to_string(dir.path().join("out/metrics.csv")).unwrap();
+    assert!(metrics.lines().next().unwrap().ends_with(",renderer"));
+    assert!(
+        metrics.lines().skip(1).all(|l| l.contains("\"gpu: ")),
+        "{metrics}"
+    );
+    let report = std::fs::read_to_string(dir.path().join("out/report.html")).unwrap();
+    assert!(report.contains("Rendered on: gpu: "));
+    // No adapter: a clear message and exit 2 for `gpu`, a fallback with the message for `auto`.
+    for (b, code) in [("gpu", 2), ("auto", 0)] {
+        let out = std::process::Command::new(env!("CARGO_BIN_EXE_lodeval"))
+            .args(["render".as_ref(), spot.as_os_str(), "-o".as_ref()])
+            .arg(dir.path().join("none.png"))
+            .args(["--size", "32", "--backend", b])
+            .env("WGPU_BACKEND", "metal")
+            .output()
+            .unwrap();
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(code), "{b}: {stderr}");
+        assert!(stderr.contains(lodeval::gpu::NO_ADAPTER), "{b}: {stderr}");
+    }
 }
