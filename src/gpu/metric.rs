@@ -60,15 +60,23 @@ impl GpuMetrics {
         gpu.clone().checked("compiling the metric kernels", || {
             Ok(GpuMetrics {
                 mse: gpu.compute_pipeline("mse.wgsl", include_str!("shaders/mse.wgsl")),
-                flip_color: gpu
-                    .compute_pipeline("flip_color.wgsl", include_str!("shaders/flip_color.wgsl")),
+                flip_color: gpu.compute_pipeline(
+                    "flip_color.wgsl",
+                    concat!(
+                        include_str!("shaders/flip_common.wgsl"),
+                        include_str!("shaders/flip_color.wgsl")
+                    ),
+                ),
                 flip_x: gpu.compute_pipeline(
                     "flip_filter_x.wgsl",
                     include_str!("shaders/flip_filter_x.wgsl"),
                 ),
                 flip_y: gpu.compute_pipeline(
                     "flip_filter_y.wgsl",
-                    include_str!("shaders/flip_filter_y.wgsl"),
+                    concat!(
+                        include_str!("shaders/flip_common.wgsl"),
+                        include_str!("shaders/flip_filter_y.wgsl")
+                    ),
                 ),
                 flip_compare: gpu.compute_pipeline(
                     "flip_compare.wgsl",

@@ -13,15 +13,6 @@ struct Dims {
 @group(0) @binding(1) var<storage, read> image: array<vec4<f32>>;
 @group(0) @binding(2) var<storage, read_write> ycxcz: array<vec4<f32>>;
 
-const INV_WHITE: vec3<f32> = vec3<f32>(1.052156925, 1.0, 0.918357670);
-
-fn rgb_to_xyz(c: vec3<f32>) -> vec3<f32> {
-    return vec3<f32>(
-        (10135552.0 / 24577794.0) * c.x + (8788810.0 / 24577794.0) * c.y + (4435075.0 / 24577794.0) * c.z,
-        (2613072.0 / 12288897.0) * c.x + (8788810.0 / 12288897.0) * c.y + (887015.0 / 12288897.0) * c.z,
-        (1425312.0 / 73733382.0) * c.x + (8788810.0 / 73733382.0) * c.y + (70074185.0 / 73733382.0) * c.z,
-    );
-}
 
 @compute @workgroup_size(64)
 fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
