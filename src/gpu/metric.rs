@@ -126,16 +126,7 @@ impl GpuMetrics {
             let out = gpu.read_back(encoder, &[&rows])?;
             let rows: &[f32] = bytemuck::cast_slice(&out[0]);
             let sum: f64 = rows[..h].iter().map(|&r| r as f64).sum();
-            let mse = sum / (w * h) as f64;
-            Ok(MseScore {
-                mse,
-                rmse: mse.sqrt(),
-                psnr_db: if mse == 0.0 {
-                    f64::INFINITY
-                } else {
-                    10.0 * (1.0 / mse).log10()
-                },
-            })
+            Ok(MseScore::from_mse(sum / (w * h) as f64))
         })
     }
 

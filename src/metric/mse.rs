@@ -25,6 +25,22 @@ pub struct MseScore {
     pub psnr_db: f64,
 }
 
+impl MseScore {
+    /// The scores for a mean squared error (PSNR +∞ for 0).
+    pub fn from_mse(mse: f64) -> MseScore {
+        let psnr_db = if mse == 0.0 {
+            f64::INFINITY
+        } else {
+            10.0 * (1.0 / mse).log10()
+        };
+        MseScore {
+            mse,
+            rmse: mse.sqrt(),
+            psnr_db,
+        }
+    }
+}
+
 /// Sum of squared luminance differences, rows in parallel, combined in row order.
 fn sum_squared(a: &LinearImage, b: &LinearImage) -> f64 {
     let w = a.width();
@@ -48,17 +64,9 @@ fn sum_squared(a: &LinearImage, b: &LinearImage) -> f64 {
 /// MSE, RMSE and PSNR of two images of equal size.
 pub fn mse(reference: &LinearImage, test: &LinearImage) -> Result<MseScore> {
     same_size(reference, test)?;
-    let mse = sum_squared(reference, test) / reference.pixels().len() as f64;
-    let psnr_db = if mse == 0.0 {
-        f64::INFINITY
-    } else {
-        10.0 * (1.0 / mse).log10()
-    };
-    Ok(MseScore {
-        mse,
-        rmse: mse.sqrt(),
-        psnr_db,
-    })
+    Ok(MseScore::from_mse(
+        sum_squared(reference, test) / reference.pixels().len() as f64,
+    ))
 }
 
 /// Lindstrom–Turk's d_MS over a set of views (eq. 1): the mean squared luminance difference over
