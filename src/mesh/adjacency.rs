@@ -20,11 +20,20 @@
 //! - Locked and non-manifold vertices never move; an edge with more than two triangles is never
 //!   collapsed.
 
-use std::collections::BTreeMap;
-
 use glam::{Vec2, Vec3};
+use smallvec::SmallVec;
 
 use super::Mesh;
+
+/// A short list of vertices, triangles or wedges: the local operations build these per call, and on
+/// the stack (the usual valence fits) they cost no allocation.
+pub type Local<T> = SmallVec<[T; 16]>;
+
+/// For a collapse of a into b: each wedge of a with the wedge of b it merges into.
+pub type WedgeMap = SmallVec<[(u32, u32); 4]>;
+
+/// Every live edge (a < b) with its live triangles (ascending), in edge order.
+pub type EdgeList = Vec<((u32, u32), SmallVec<[u32; 2]>)>;
 
 /// How a vertex may be treated.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
@@ -178,8 +187,8 @@ impl Adjacency {
     }
 
     /// The wedges used by `v`'s corners, ascending.
-    pub fn vertex_wedges(&self, v: u32) -> Vec<u32> {
-        let mut w: Vec<u32> = self.vtris[v as usize]
+    pub fn vertex_wedges(&self, v: u32) -> Local<u32> {
+        let mut w: Local<u32> = self.vtris[v as usize]
             .iter()
             .map(|&t| self.corner_wedge(t, v))
             .collect();
@@ -189,7 +198,7 @@ impl Adjacency {
     }
 
     /// For a collapse of `a` into `b`: each wedge of `a` with its partner wedge of `b`.
-    pub fn collapse_wedge_map(&self, a: u32, b: u32) -> Result<Vec<(u32, u32)>, Reject> {
+    pub fn collapse_wedge_map(&self, a: u32, b: u32) -> Result<WedgeMap, Reject> {
         let shared = self.edge_triangles(a, b);
         if shared.is_empty() {
             return Err(Reject::NoSuchEdge);
@@ -204,13 +213,21 @@ impl Adjacency {
     }
 
     /// Every live edge (a < b) with its live triangles, in edge order.
-    pub fn edge_map(&self) -> BTreeMap<(u32, u32), Vec<u32>> {
-        let mut edges: BTreeMap<(u32, u32), Vec<u32>> = BTreeMap::new();
+    pub fn edge_map(&self) -> EdgeList {
+        let mut half: Vec<((u32, u32), u32)> = Vec::with_capacity(3 * self.alive_count);
         for t in self.live_triangles() {
             let x = self.tris[t as usize];
             for k in 0..3 {
                 let (a, b) = (x[k], x[(k + 1) % 3]);
-                edges.entry((a.min(b), a.max(b))).or_default().push(t);
+                half.push(((a.min(b), a.max(b)), t));
+            }
+        }
+        half.sort_unstable();
+        let mut edges: EdgeList = Vec::with_capacity(half.len() / 2 + 1);
+        for (e, t) in half {
+            match edges.last_mut() {
+                Some((last, ts)) if *last == e => ts.push(t),
+                _ => edges.push((e, SmallVec::from_slice(&[t]))),
             }
         }
         edges
@@ -279,8 +296,8 @@ impl Adjacency {
     }
 
     /// Vertices adjacent to `v`, ascending.
-    pub fn neighbours(&self, v: u32) -> Vec<u32> {
-        let mut n: Vec<u32> = self.vtris[v as usize]
+    pub fn neighbours(&self, v: u32) -> Local<u32> {
+        let mut n: Local<u32> = self.vtris[v as usize]
             .iter()
             .flat_map(|&t| self.tris[t as usize])
             .filter(|&x| x != v)
@@ -291,7 +308,7 @@ impl Adjacency {
     }
 
     /// Live triangles containing both `a` and `b`.
-    pub fn edge_triangles(&self, a: u32, b: u32) -> Vec<u32> {
+    pub fn edge_triangles(&self, a: u32, b: u32) -> Local<u32> {
         self.vtris[a as usize]
             .iter()
             .copied()
@@ -369,6 +386,11 @@ impl Adjacency {
 
     /// Check a collapse of `a` into `b` (b moves to `p`) without doing it.
     pub fn can_collapse(&self, a: u32, b: u32, p: Vec3) -> Result<(), Reject> {
+        self.check_collapse(a, b, p).map(|_| ())
+    }
+
+    /// [`Adjacency::can_collapse`], returning the triangles on the edge and the wedge map.
+    fn check_collapse(&self, a: u32, b: u32, p: Vec3) -> Result<(Local<u32>, WedgeMap), Reject> {
         if a == b || self.vtris[a as usize].is_empty() || self.vtris[b as usize].is_empty() {
             return Err(Reject::NoSuchEdge);
         }
@@ -399,18 +421,18 @@ impl Adjacency {
         if shared.len() == 2 && self.class[a as usize] == VertexClass::Border {
             return Err(Reject::Link);
         }
-        self.wedge_map(a, b, &shared)?;
+        let map = self.wedge_map(a, b, &shared)?;
         if self.folds(&self.vtris[a as usize], a, p, b)
             || self.folds(&self.vtris[b as usize], b, p, a)
         {
             return Err(Reject::FoldOver);
         }
-        Ok(())
+        Ok((shared, map))
     }
 
     /// For each wedge of `a`, its partner wedge of `b` across the edge.
-    fn wedge_map(&self, a: u32, b: u32, shared: &[u32]) -> Result<Vec<(u32, u32)>, Reject> {
-        let mut map: Vec<(u32, u32)> = Vec::new();
+    fn wedge_map(&self, a: u32, b: u32, shared: &[u32]) -> Result<WedgeMap, Reject> {
+        let mut map = WedgeMap::new();
         for &t in shared {
             let tri = self.tris[t as usize];
             let ka = tri.iter().position(|&x| x == a).unwrap();
@@ -433,11 +455,9 @@ impl Adjacency {
 
     /// Collapse `a` into `b`, moving `b` to `p`. Returns the undo record.
     pub fn collapse(&mut self, a: u32, b: u32, p: Vec3) -> Result<Undo, Reject> {
-        self.can_collapse(a, b, p)?;
-        let shared = self.edge_triangles(a, b);
-        let map = self.wedge_map(a, b, &shared)?;
+        let (shared, map) = self.check_collapse(a, b, p)?;
         let mut undo = self.begin();
-        let mut touched: Vec<u32> = vec![a, b];
+        let mut touched: Local<u32> = SmallVec::from_slice(&[a, b]);
         for &t in &shared {
             touched.extend(self.tris[t as usize]);
         }
@@ -449,7 +469,21 @@ impl Adjacency {
         for &t in &self.vtris[a as usize] {
             self.snapshot_tri(&mut undo, t);
         }
-        for &t in &shared {
+        self.apply_collapse(a, b, p, &shared, &map);
+        Ok(undo)
+    }
+
+    /// Collapse `a` into `b`, moving `b` to `p`, without an undo record (for a simplifier that
+    /// never reverts). Returns the wedge map of the collapse.
+    pub fn collapse_for_good(&mut self, a: u32, b: u32, p: Vec3) -> Result<WedgeMap, Reject> {
+        let (shared, map) = self.check_collapse(a, b, p)?;
+        self.apply_collapse(a, b, p, &shared, &map);
+        Ok(map)
+    }
+
+    /// The changes of a checked collapse.
+    fn apply_collapse(&mut self, a: u32, b: u32, p: Vec3, shared: &[u32], map: &[(u32, u32)]) {
+        for &t in shared {
             self.alive[t as usize] = false;
             self.alive_count -= 1;
             for v in self.tris[t as usize] {
@@ -468,7 +502,6 @@ impl Adjacency {
         self.positions[b as usize] = p;
         let (ca, cb) = (self.class[a as usize], self.class[b as usize]);
         self.class[b as usize] = ca.max(cb);
-        Ok(undo)
     }
 
     /// Split edge ab at its midpoint: a new vertex, and each triangle on the edge becomes two.
@@ -688,12 +721,12 @@ impl Adjacency {
 
     /// Edges used by more than two live triangles.
     pub fn non_manifold_edges(&self) -> usize {
-        self.edge_map().values().filter(|ts| ts.len() > 2).count()
+        self.edge_map().iter().filter(|(_, ts)| ts.len() > 2).count()
     }
 
     /// Border edges (one live triangle).
     pub fn border_edges(&self) -> usize {
-        self.edge_map().values().filter(|ts| ts.len() == 1).count()
+        self.edge_map().iter().filter(|(_, ts)| ts.len() == 1).count()
     }
 
     /// The current mesh: one output vertex per used wedge, at its welded vertex's position.

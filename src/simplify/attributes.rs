@@ -35,6 +35,8 @@ pub const COLOR_SCALE: f64 = 0.1;
 
 const MAX_M: usize = 8;
 const MAX_N: usize = 3 + MAX_M;
+/// Packed size of an n = `MAX_N` quadric.
+const STRIDE_MAX: usize = MAX_N * (MAX_N + 1) / 2 + MAX_N + 1;
 
 /// One generalized quadric per wedge, packed: the upper triangle of A (row-major), then b, then c.
 #[derive(Debug, Clone)]
@@ -101,7 +103,7 @@ impl AttributeQuadrics {
             }
             e2.iter_mut().take(n).for_each(|x| *x /= l2);
             let (pe1, pe2) = (dot(p0, &e1, n), dot(p0, &e2, n));
-            let mut k = vec![0.0; stride];
+            let mut k = [0.0; STRIDE_MAX];
             for i in 0..n {
                 for j in i..n {
                     let id = if i == j { 1.0 } else { 0.0 };
@@ -115,7 +117,7 @@ impl AttributeQuadrics {
             k[off + n] = area * (dot(p0, p0, n) - pe1 * pe1 - pe2 * pe2);
             for w in corners {
                 let base = w as usize * stride;
-                for (dst, src) in q.data[base..base + stride].iter_mut().zip(&k) {
+                for (dst, src) in q.data[base..base + stride].iter_mut().zip(&k[..stride]) {
                     *dst += src;
                 }
             }
@@ -170,15 +172,29 @@ impl AttributeQuadrics {
 
     /// For the summed quadric of `wedges` at position `x`: the optimal attributes (as a wedge,
     /// starting from `keep` where the system is singular) and the quadric's value there.
+    pub fn optimal(&self, wedges: &[u32], x: DVec3, keep: &Wedge) -> (Wedge, f64) {
+        // One instance per dimension, so every loop below has a constant trip count (this runs
+        // for every queued edge; the instances unroll).
+        match self.n() {
+            6 => self.optimal_n::<6>(wedges, x, keep),
+            8 => self.optimal_n::<8>(wedges, x, keep),
+            9 => self.optimal_n::<9>(wedges, x, keep),
+            11 => self.optimal_n::<11>(wedges, x, keep),
+            n => unreachable!("attribute quadrics of dimension {n}"),
+        }
+    }
+
     // Dense linear algebra on fixed-size arrays: index loops read like the formulas.
     #[allow(clippy::needless_range_loop)]
-    pub fn optimal(&self, wedges: &[u32], x: DVec3, keep: &Wedge) -> (Wedge, f64) {
-        let (n, m) = (self.n(), self.m);
-        let mut q = [0.0; 78];
+    fn optimal_n<const N: usize>(&self, wedges: &[u32], x: DVec3, keep: &Wedge) -> (Wedge, f64) {
+        let (n, m) = (N, N - 3);
+        let stride = n * (n + 1) / 2 + n + 1;
+        debug_assert_eq!(stride, self.stride);
+        let mut q = [0.0; STRIDE_MAX];
         for &w in wedges {
-            let base = w as usize * self.stride;
-            for i in 0..self.stride {
-                q[i] += self.data[base + i];
+            let base = w as usize * stride;
+            for (qi, d) in q[..stride].iter_mut().zip(&self.data[base..base + stride]) {
+                *qi += d;
             }
         }
         let off = n * (n + 1) / 2;

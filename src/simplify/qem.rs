@@ -30,7 +30,7 @@ use glam::{DVec3, Vec3};
 use super::attributes::AttributeQuadrics;
 use crate::error::Result;
 use crate::mesh::Mesh;
-use crate::mesh::adjacency::{Adjacency, Wedge};
+use crate::mesh::adjacency::{Adjacency, Local, Wedge};
 
 /// Weight of border constraint planes (× edge length²).
 pub const BORDER_WEIGHT: f64 = 1000.0;
@@ -124,6 +124,13 @@ impl Quadric {
 pub trait CollapseCost {
     /// Cost (lower collapses first), the new position, and the error to record (model units).
     fn evaluate(&self, adj: &Adjacency, a: u32, b: u32) -> (f64, Vec3, f64);
+    /// The new position and the error of collapsing `a` into `b` (what [`CollapseCost::evaluate`]
+    /// returns besides the cost). The engine asks for this when it applies a queued collapse;
+    /// a cost whose placement is cheaper than its full cost overrides it.
+    fn placement(&self, adj: &Adjacency, a: u32, b: u32) -> (Vec3, f64) {
+        let (_, p, err) = self.evaluate(adj, a, b);
+        (p, err)
+    }
     /// `a` was collapsed into `b` (already applied to `adj`; `map` pairs each wedge of `a` with
     /// the wedge of `b` it merged into). The cost may set new wedge attributes in `adj`; it
     /// returns them so the progressive record can replay them.
@@ -198,21 +205,19 @@ impl QemCost {
     }
 
     /// The wedge groups after collapsing `a` into `b`: each wedge of `b` with the wedges of `a`
-    /// that merge into it.
-    fn groups(adj: &Adjacency, b: u32, map: &[(u32, u32)]) -> Vec<(u32, Vec<u32>)> {
-        adj.vertex_wedges(b)
-            .into_iter()
-            .map(|wb| {
-                let mut g = vec![wb];
-                g.extend(map.iter().filter(|(_, y)| *y == wb).map(|(x, _)| *x));
-                (wb, g)
-            })
-            .collect()
+    /// that merge into it, handed to `f` one by one (no allocation: this runs for every queued edge).
+    fn for_groups(adj: &Adjacency, b: u32, map: &[(u32, u32)], mut f: impl FnMut(u32, &[u32])) {
+        let mut g: Local<u32> = Local::new();
+        for wb in adj.vertex_wedges(b) {
+            g.clear();
+            g.push(wb);
+            g.extend(map.iter().filter(|(_, y)| *y == wb).map(|(x, _)| *x));
+            f(wb, &g);
+        }
     }
-}
 
-impl CollapseCost for QemCost {
-    fn evaluate(&self, adj: &Adjacency, a: u32, b: u32) -> (f64, Vec3, f64) {
+    /// The geometric part: the quadric of the merged vertex and where it goes.
+    fn place(&self, adj: &Adjacency, a: u32, b: u32) -> (Quadric, DVec3) {
         let q = self.quadrics[a as usize].add(&self.quadrics[b as usize]);
         let (pa, pb) = (
             adj.positions[a as usize].as_dvec3(),
@@ -230,15 +235,27 @@ impl CollapseCost for QemCost {
                     .unwrap(),
             }
         };
+        (q, p)
+    }
+}
+
+impl CollapseCost for QemCost {
+    fn evaluate(&self, adj: &Adjacency, a: u32, b: u32) -> (f64, Vec3, f64) {
+        let (q, p) = self.place(adj, a, b);
         let mut cost = q.eval(p);
         if let Some(attrs) = &self.attributes
             && let Ok(map) = adj.collapse_wedge_map(a, b)
         {
-            for (wb, group) in Self::groups(adj, b, &map) {
-                cost += attrs.optimal(&group, p, &adj.wedges[wb as usize]).1;
-            }
+            Self::for_groups(adj, b, &map, |wb, group| {
+                cost += attrs.optimal(group, p, &adj.wedges[wb as usize]).1;
+            });
         }
         (cost, p.as_vec3(), q.rms(p))
+    }
+
+    fn placement(&self, adj: &Adjacency, a: u32, b: u32) -> (Vec3, f64) {
+        let (q, p) = self.place(adj, a, b);
+        (p.as_vec3(), q.rms(p))
     }
 
     fn collapsed(
@@ -254,13 +271,15 @@ impl CollapseCost for QemCost {
         };
         let mut changes = Vec::new();
         let x = adj.positions[b as usize].as_dvec3();
-        for (wb, group) in Self::groups(adj, b, map) {
-            let (w, _) = attrs.optimal(&group, x, &adj.wedges[wb as usize]);
+        Self::for_groups(adj, b, map, |wb, group| {
+            let (w, _) = attrs.optimal(group, x, &adj.wedges[wb as usize]);
             for &wa in &group[1..] {
                 attrs.merge(wb, wa);
             }
-            adj.wedges[wb as usize] = w;
             changes.push((wb, w));
+        });
+        for &(wb, w) in &changes {
+            adj.wedges[wb as usize] = w;
         }
         changes
     }
@@ -391,7 +410,7 @@ pub fn run(adj: Adjacency, cost: &mut dyn CollapseCost, stop: Stop, diagonal: f6
         if version[a as usize] != va || version[b as usize] != vb {
             continue;
         }
-        let (_, p, err) = cost.evaluate(&adj, a, b);
+        let (p, err) = cost.placement(&adj, a, b);
         if err > limit {
             break;
         }
@@ -405,8 +424,7 @@ pub fn run(adj: Adjacency, cost: &mut dyn CollapseCost, stop: Stop, diagonal: f6
         } else {
             continue;
         };
-        let map = adj.collapse_wedge_map(from, to).expect("checked");
-        adj.collapse(from, to, p).expect("checked");
+        let map = adj.collapse_for_good(from, to, p).expect("checked");
         let attributes = cost.collapsed(&mut adj, from, to, &map);
         version[from as usize] += 1;
         version[to as usize] += 1;
