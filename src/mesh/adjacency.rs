@@ -75,6 +75,10 @@ pub struct Adjacency {
     vtris: Vec<Vec<u32>>,
     class: Vec<VertexClass>,
     locked: Vec<bool>,
+    /// The vertex had a single wedge when it was made. Operations never give a vertex a wedge it
+    /// did not have (a collapse maps a's wedges onto b's, a swap or split keeps each vertex's
+    /// wedges), so it still has exactly one: the wedge look-ups take a shortcut for it.
+    single_wedge: Vec<bool>,
     alive_count: usize,
     has_uvs: bool,
     has_colors: bool,
@@ -135,6 +139,7 @@ impl Adjacency {
             vtris: vec![Vec::new(); positions.len()],
             class: vec![VertexClass::Interior; positions.len()],
             locked: vec![false; positions.len()],
+            single_wedge: Vec::new(),
             materials: mesh.material_ids().to_vec(),
             positions,
             wedges,
@@ -152,6 +157,9 @@ impl Adjacency {
                 }
             }
         }
+        adj.single_wedge = (0..adj.positions.len() as u32)
+            .map(|v| adj.vertex_wedges(v).len() == 1)
+            .collect();
         adj.classify();
         adj
     }
@@ -188,12 +196,18 @@ impl Adjacency {
 
     /// The wedges used by `v`'s corners, ascending.
     pub fn vertex_wedges(&self, v: u32) -> Local<u32> {
-        let mut w: Local<u32> = self.vtris[v as usize]
-            .iter()
-            .map(|&t| self.corner_wedge(t, v))
-            .collect();
-        w.sort_unstable();
-        w.dedup();
+        let ts = &self.vtris[v as usize];
+        if ts.len() > 0 && self.single_wedge.get(v as usize) == Some(&true) {
+            return Local::from_slice(&[self.corner_wedge(ts[0], v)]);
+        }
+        let mut w: Local<u32> = ts.iter().map(|&t| self.corner_wedge(t, v)).collect();
+        // Most vertices have one wedge: no sort for them.
+        if w.iter().any(|&x| x != w[0]) {
+            w.sort_unstable();
+            w.dedup();
+        } else {
+            w.truncate(1);
+        }
         w
     }
 
@@ -208,7 +222,15 @@ impl Adjacency {
 
     /// The wedge of `v`'s corner in triangle `t` (which must use `v`).
     pub fn corner_wedge(&self, t: u32, v: u32) -> u32 {
-        let k = self.tris[t as usize].iter().position(|&x| x == v).unwrap();
+        let tri = self.tris[t as usize];
+        let k = if tri[0] == v {
+            0
+        } else if tri[1] == v {
+            1
+        } else {
+            debug_assert_eq!(tri[2], v, "triangle {t} does not use vertex {v}");
+            2
+        };
         self.corners[t as usize][k]
     }
 
@@ -433,6 +455,12 @@ impl Adjacency {
     /// For each wedge of `a`, its partner wedge of `b` across the edge.
     fn wedge_map(&self, a: u32, b: u32, shared: &[u32]) -> Result<WedgeMap, Reject> {
         let mut map = WedgeMap::new();
+        if self.single_wedge[a as usize] && self.single_wedge[b as usize] {
+            // One wedge each: every shared triangle pairs the same two.
+            let t = shared[0];
+            map.push((self.corner_wedge(t, a), self.corner_wedge(t, b)));
+            return Ok(map);
+        }
         for &t in shared {
             let tri = self.tris[t as usize];
             let ka = tri.iter().position(|&x| x == a).unwrap();
@@ -528,6 +556,7 @@ impl Adjacency {
             .push(0.5 * (self.positions[a as usize] + self.positions[b as usize]));
         self.vtris.push(Vec::new());
         self.locked.push(false);
+        self.single_wedge.push(false);
         let border = shared.len() == 1;
         self.class.push(if border {
             VertexClass::Border
@@ -579,6 +608,7 @@ impl Adjacency {
             }
             self.vtris[m as usize].push(t);
         }
+        self.single_wedge[m as usize] = made.len() == 1;
         let touched: Vec<u32> = undo.verts.iter().map(|v| v.0).chain([m]).collect();
         for v in touched {
             self.vtris[v as usize].sort_unstable();
@@ -670,6 +700,7 @@ impl Adjacency {
         self.vtris.truncate(np);
         self.class.truncate(np);
         self.locked.truncate(np);
+        self.single_wedge.truncate(np);
         self.wedges.truncate(nw);
         self.tris.truncate(nt);
         self.corners.truncate(nt);
@@ -721,12 +752,18 @@ impl Adjacency {
 
     /// Edges used by more than two live triangles.
     pub fn non_manifold_edges(&self) -> usize {
-        self.edge_map().iter().filter(|(_, ts)| ts.len() > 2).count()
+        self.edge_map()
+            .iter()
+            .filter(|(_, ts)| ts.len() > 2)
+            .count()
     }
 
     /// Border edges (one live triangle).
     pub fn border_edges(&self) -> usize {
-        self.edge_map().iter().filter(|(_, ts)| ts.len() == 1).count()
+        self.edge_map()
+            .iter()
+            .filter(|(_, ts)| ts.len() == 1)
+            .count()
     }
 
     /// The current mesh: one output vertex per used wedge, at its welded vertex's position.

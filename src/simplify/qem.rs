@@ -26,6 +26,7 @@ use std::cmp::Reverse;
 use std::collections::BinaryHeap;
 
 use glam::{DVec3, Vec3};
+use rayon::prelude::*;
 
 use super::attributes::AttributeQuadrics;
 use crate::error::Result;
@@ -121,7 +122,7 @@ impl Quadric {
 
 /// A collapse cost: the engine asks it for the cost and placement of collapsing `a` into `b`,
 /// and tells it about accepted collapses.
-pub trait CollapseCost {
+pub trait CollapseCost: Sync {
     /// Cost (lower collapses first), the new position, and the error to record (model units).
     fn evaluate(&self, adj: &Adjacency, a: u32, b: u32) -> (f64, Vec3, f64);
     /// The new position and the error of collapsing `a` into `b` (what [`CollapseCost::evaluate`]
@@ -368,13 +369,7 @@ pub fn run(adj: Adjacency, cost: &mut dyn CollapseCost, stop: Stop, diagonal: f6
     let base = adj.clone();
     let mut adj = adj;
     let mut version = vec![0u32; adj.positions.len()];
-    let mut heap: BinaryHeap<Entry> = BinaryHeap::new();
-    let push = |heap: &mut BinaryHeap<Entry>,
-                adj: &Adjacency,
-                cost: &dyn CollapseCost,
-                version: &[u32],
-                u: u32,
-                v: u32| {
+    let entry = |adj: &Adjacency, cost: &dyn CollapseCost, version: &[u32], u: u32, v: u32| {
         // Prefer moving the vertex that may move: collapse the lower class into the higher.
         let (a, b) = if adj.is_locked(u) || adj.class(u) > adj.class(v) {
             (v, u)
@@ -382,20 +377,29 @@ pub fn run(adj: Adjacency, cost: &mut dyn CollapseCost, stop: Stop, diagonal: f6
             (u, v)
         };
         if adj.is_locked(a) {
-            return;
+            return None;
         }
         let (c, _, _) = cost.evaluate(adj, a, b);
-        heap.push(Reverse((
+        Some(Reverse((
             c.max(0.0).to_bits(),
             a,
             b,
             version[a as usize],
             version[b as usize],
-        )));
+        )))
     };
-    for (u, v) in adj.edges() {
-        push(&mut heap, &adj, cost, &version, u, v);
-    }
+    // The first costs of all edges are independent: evaluated in parallel, then heapified in one
+    // go. Entries are totally ordered (cost, then vertex ids), so the pop order — and the result
+    // — does not depend on the thread count.
+    let initial: Vec<Entry> = {
+        let (adj, cost, version) = (&adj, &*cost, &version);
+        adj.edges()
+            .par_iter()
+            .with_min_len(1024)
+            .filter_map(|&(u, v)| entry(adj, cost, version, u, v))
+            .collect()
+    };
+    let mut heap = BinaryHeap::from(initial);
     let mut collapses = Vec::new();
     let limit = match stop {
         Stop::RelativeError(e) => e * diagonal,
@@ -439,7 +443,7 @@ pub fn run(adj: Adjacency, cost: &mut dyn CollapseCost, stop: Stop, diagonal: f6
         // Only the edges around `to` changed (its quadric and position); their old entries
         // carry `to`'s old version and are skipped when popped.
         for n in adj.neighbours(to) {
-            push(&mut heap, &adj, cost, &version, to, n);
+            heap.extend(entry(&adj, cost, &version, to, n));
         }
     }
     Progressive {
