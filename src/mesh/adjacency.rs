@@ -197,7 +197,7 @@ impl Adjacency {
     /// The wedges used by `v`'s corners, ascending.
     pub fn vertex_wedges(&self, v: u32) -> Local<u32> {
         let ts = &self.vtris[v as usize];
-        if ts.len() > 0 && self.single_wedge.get(v as usize) == Some(&true) {
+        if !ts.is_empty() && self.single_wedge.get(v as usize) == Some(&true) {
             return Local::from_slice(&[self.corner_wedge(ts[0], v)]);
         }
         let mut w: Local<u32> = ts.iter().map(|&t| self.corner_wedge(t, v)).collect();
