@@ -35,6 +35,9 @@ pub type WedgeMap = SmallVec<[(u32, u32); 4]>;
 /// Every live edge (a < b) with its live triangles (ascending), in edge order.
 pub type EdgeList = Vec<((u32, u32), SmallVec<[u32; 2]>)>;
 
+/// [`Adjacency`]'s marker for a vertex with several wedges.
+const SEVERAL: u32 = u32::MAX;
+
 /// How a vertex may be treated.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
 pub enum VertexClass {
@@ -75,10 +78,11 @@ pub struct Adjacency {
     vtris: Vec<Vec<u32>>,
     class: Vec<VertexClass>,
     locked: Vec<bool>,
-    /// The vertex had a single wedge when it was made. Operations never give a vertex a wedge it
-    /// did not have (a collapse maps a's wedges onto b's, a swap or split keeps each vertex's
-    /// wedges), so it still has exactly one: the wedge look-ups take a shortcut for it.
-    single_wedge: Vec<bool>,
+    /// The vertex's wedge if it had a single one when it was made, else [`SEVERAL`]. Operations
+    /// never give a vertex a wedge it did not have (a collapse maps a's wedges onto b's, a swap or
+    /// split keeps each vertex's wedges), so it still has exactly that one: the wedge look-ups
+    /// read it from here instead of from the vertex's triangles.
+    only_wedge: Vec<u32>,
     alive_count: usize,
     has_uvs: bool,
     has_colors: bool,
@@ -139,7 +143,7 @@ impl Adjacency {
             vtris: vec![Vec::new(); positions.len()],
             class: vec![VertexClass::Interior; positions.len()],
             locked: vec![false; positions.len()],
-            single_wedge: Vec::new(),
+            only_wedge: Vec::new(),
             materials: mesh.material_ids().to_vec(),
             positions,
             wedges,
@@ -157,8 +161,11 @@ impl Adjacency {
                 }
             }
         }
-        adj.single_wedge = (0..adj.positions.len() as u32)
-            .map(|v| adj.vertex_wedges(v).len() == 1)
+        adj.only_wedge = (0..adj.positions.len() as u32)
+            .map(|v| match adj.vertex_wedges(v).as_slice() {
+                &[w] => w,
+                _ => SEVERAL,
+            })
             .collect();
         adj.classify();
         adj
@@ -197,8 +204,9 @@ impl Adjacency {
     /// The wedges used by `v`'s corners, ascending.
     pub fn vertex_wedges(&self, v: u32) -> Local<u32> {
         let ts = &self.vtris[v as usize];
-        if !ts.is_empty() && self.single_wedge.get(v as usize) == Some(&true) {
-            return Local::from_slice(&[self.corner_wedge(ts[0], v)]);
+        match self.only_wedge.get(v as usize) {
+            Some(&w) if w != SEVERAL && !ts.is_empty() => return Local::from_slice(&[w]),
+            _ => {}
         }
         let mut w: Local<u32> = ts.iter().map(|&t| self.corner_wedge(t, v)).collect();
         // Most vertices have one wedge: no sort for them.
@@ -218,6 +226,16 @@ impl Adjacency {
             return Err(Reject::NoSuchEdge);
         }
         self.wedge_map(a, b, &shared)
+    }
+
+    /// [`Adjacency::collapse_wedge_map`] for an `a`, `b` known to be an edge: two single-wedge
+    /// vertices pair their wedges without a look at the triangles.
+    pub fn edge_wedge_map(&self, a: u32, b: u32) -> Result<WedgeMap, Reject> {
+        let (wa, wb) = (self.only_wedge[a as usize], self.only_wedge[b as usize]);
+        if wa != SEVERAL && wb != SEVERAL {
+            return Ok(SmallVec::from_slice(&[(wa, wb)]));
+        }
+        self.collapse_wedge_map(a, b)
     }
 
     /// The wedge of `v`'s corner in triangle `t` (which must use `v`).
@@ -455,10 +473,10 @@ impl Adjacency {
     /// For each wedge of `a`, its partner wedge of `b` across the edge.
     fn wedge_map(&self, a: u32, b: u32, shared: &[u32]) -> Result<WedgeMap, Reject> {
         let mut map = WedgeMap::new();
-        if self.single_wedge[a as usize] && self.single_wedge[b as usize] {
+        let (wa, wb) = (self.only_wedge[a as usize], self.only_wedge[b as usize]);
+        if wa != SEVERAL && wb != SEVERAL {
             // One wedge each: every shared triangle pairs the same two.
-            let t = shared[0];
-            map.push((self.corner_wedge(t, a), self.corner_wedge(t, b)));
+            map.push((wa, wb));
             return Ok(map);
         }
         for &t in shared {
@@ -556,7 +574,7 @@ impl Adjacency {
             .push(0.5 * (self.positions[a as usize] + self.positions[b as usize]));
         self.vtris.push(Vec::new());
         self.locked.push(false);
-        self.single_wedge.push(false);
+        self.only_wedge.push(SEVERAL);
         let border = shared.len() == 1;
         self.class.push(if border {
             VertexClass::Border
@@ -608,7 +626,9 @@ impl Adjacency {
             }
             self.vtris[m as usize].push(t);
         }
-        self.single_wedge[m as usize] = made.len() == 1;
+        if let [(_, w)] = made[..] {
+            self.only_wedge[m as usize] = w;
+        }
         let touched: Vec<u32> = undo.verts.iter().map(|v| v.0).chain([m]).collect();
         for v in touched {
             self.vtris[v as usize].sort_unstable();
@@ -700,7 +720,7 @@ impl Adjacency {
         self.vtris.truncate(np);
         self.class.truncate(np);
         self.locked.truncate(np);
-        self.single_wedge.truncate(np);
+        self.only_wedge.truncate(np);
         self.wedges.truncate(nw);
         self.tris.truncate(nt);
         self.corners.truncate(nt);

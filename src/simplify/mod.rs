@@ -9,6 +9,7 @@ pub mod cluster;
 pub mod lindstrom_turk;
 pub mod meshopt;
 pub mod qem;
+mod queue;
 pub mod williams;
 
 use crate::error::{Error, Result};

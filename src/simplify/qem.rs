@@ -8,8 +8,8 @@
 //!   place as well as never torn (the adjacency's wedge rule does the latter).
 //! - Placement: the optimum v̄ = −A⁻¹b when A is well conditioned (|det| above 1e-9 of the scale),
 //!   else the best of the two endpoints and the midpoint (§4 fallback).
-//! - Queue: a binary heap of (cost, edge) with lazy invalidation by per-vertex version stamps;
-//!   ties are broken by vertex ids, so the collapse sequence is deterministic.
+//! - Queue: a 4-ary min-heap (`queue.rs`) of (cost, edge) with lazy invalidation by per-vertex
+//!   version stamps; ties are broken by vertex ids, so the collapse sequence is deterministic.
 //! - The record of every accepted collapse (a progressive mesh, Hoppe 1996) lets any LOD of a
 //!   chain be extracted by replaying a prefix; the perceptual simplifiers plug their own cost in
 //!   through [`CollapseCost`].
@@ -22,13 +22,11 @@
 //! (`attributes.rs`); it adds to the cost, and the surviving wedges get the attribute values that
 //! minimise it. Without it ([`QemCost::new`]) a surviving corner keeps its partner wedge's values.
 
-use std::cmp::Reverse;
-use std::collections::BinaryHeap;
-
 use glam::{DVec3, Vec3};
 use rayon::prelude::*;
 
 use super::attributes::AttributeQuadrics;
+use super::queue::MinQueue;
 use crate::error::Result;
 use crate::mesh::Mesh;
 use crate::mesh::adjacency::{Adjacency, Local, Wedge};
@@ -245,7 +243,7 @@ impl CollapseCost for QemCost {
         let (q, p) = self.place(adj, a, b);
         let mut cost = q.eval(p);
         if let Some(attrs) = &self.attributes
-            && let Ok(map) = adj.collapse_wedge_map(a, b)
+            && let Ok(map) = adj.edge_wedge_map(a, b)
         {
             Self::for_groups(adj, b, &map, |wb, group| {
                 cost += attrs.optimal(group, p, &adj.wedges[wb as usize]).1;
@@ -361,8 +359,24 @@ impl Progressive {
     }
 }
 
-/// Queue entry: (cost bits, a, b, version of a, version of b); the smallest pops first.
-type Entry = Reverse<(u64, u32, u32, u32, u32)>;
+/// Queue entry, ordered by cost, then the vertex ids: the smallest pops first. 20 bytes (the queue
+/// holds millions of them on large meshes).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
+struct Entry {
+    /// High and low halves of the cost's bits (a non-negative f64 orders like its bits).
+    cost: [u32; 2],
+    a: u32,
+    b: u32,
+    /// version[a] + version[b] when queued. Versions only grow, so the sum is unchanged exactly
+    /// when neither vertex has changed since.
+    stamp: u32,
+}
+
+impl Entry {
+    fn current(&self, version: &[u32]) -> bool {
+        version[self.a as usize].wrapping_add(version[self.b as usize]) == self.stamp
+    }
+}
 
 /// Run the edge-collapse engine on `adj` with `cost` until `stop`.
 pub fn run(adj: Adjacency, cost: &mut dyn CollapseCost, stop: Stop, diagonal: f64) -> Progressive {
@@ -380,13 +394,13 @@ pub fn run(adj: Adjacency, cost: &mut dyn CollapseCost, stop: Stop, diagonal: f6
             return None;
         }
         let (c, _, _) = cost.evaluate(adj, a, b);
-        Some(Reverse((
-            c.max(0.0).to_bits(),
+        let bits = c.max(0.0).to_bits();
+        Some(Entry {
+            cost: [(bits >> 32) as u32, bits as u32],
             a,
             b,
-            version[a as usize],
-            version[b as usize],
-        )))
+            stamp: version[a as usize].wrapping_add(version[b as usize]),
+        })
     };
     // The first costs of all edges are independent: evaluated in parallel, then heapified in one
     // go. Entries are totally ordered (cost, then vertex ids), so the pop order — and the result
@@ -399,20 +413,31 @@ pub fn run(adj: Adjacency, cost: &mut dyn CollapseCost, stop: Stop, diagonal: f6
             .filter_map(|&(u, v)| entry(adj, cost, version, u, v))
             .collect()
     };
-    let mut heap = BinaryHeap::from(initial);
+    let mut heap = MinQueue::from_vec(initial);
     let mut collapses = Vec::new();
     let limit = match stop {
         Stop::RelativeError(e) => e * diagonal,
         Stop::Triangles(_) => f64::INFINITY,
     };
-    while let Some(Reverse((_, a, b, va, vb))) = heap.pop() {
+    let mut rebuild_at = 2 * heap.len().max(1024);
+    while let Some(e) = heap.pop() {
         if let Stop::Triangles(n) = stop
             && adj.triangle_count() <= n
         {
             break;
         }
-        if version[a as usize] != va || version[b as usize] != vb {
+        if !e.current(&version) {
             continue;
+        }
+        let (a, b) = (e.a, e.b);
+        // Every collapse leaves the old entries of the edges around the kept vertex behind. When
+        // the heap has doubled since it last held only current entries, at least half of it is
+        // stale: those are dropped in one linear pass (amortised O(1) per push) instead of being
+        // popped one by one from a heap grown too large for the caches. The current entries
+        // keep their order, so the collapse sequence is the same.
+        if heap.len() > rebuild_at {
+            heap.retain(|e| e.current(&version));
+            rebuild_at = 2 * heap.len().max(1024);
         }
         let (p, err) = cost.placement(&adj, a, b);
         if err > limit {
@@ -443,7 +468,9 @@ pub fn run(adj: Adjacency, cost: &mut dyn CollapseCost, stop: Stop, diagonal: f6
         // Only the edges around `to` changed (its quadric and position); their old entries
         // carry `to`'s old version and are skipped when popped.
         for n in adj.neighbours(to) {
-            heap.extend(entry(&adj, cost, &version, to, n));
+            if let Some(e) = entry(&adj, cost, &version, to, n) {
+                heap.push(e);
+            }
         }
     }
     Progressive {
