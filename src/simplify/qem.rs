@@ -573,6 +573,30 @@ mod tests {
     }
 
     #[test]
+    fn the_collapse_sequence_does_not_depend_on_the_thread_count() {
+        // The first edge costs are evaluated in parallel; the queue's total order makes the
+        // sequence the same for any pool size (Spot: UV seams, so several wedges per vertex).
+        let spot = crate::mesh::load(
+            &std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+                .join("reference/models/spot/spot_mtl.obj"),
+            &LoadOptions::default(),
+        )
+        .unwrap();
+        let run_with = |threads: usize| {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap();
+            pool.install(|| progressive(&spot, Stop::Triangles(spot.triangle_count() / 20)))
+                .collapses
+        };
+        let one = run_with(1);
+        assert!(one.len() > spot.triangle_count() / 3);
+        assert_eq!(one, run_with(2));
+        assert_eq!(one, run_with(8));
+    }
+
+    #[test]
     fn quadric_optimum_and_fallback() {
         let q = Quadric::plane(DVec3::X, -1.0, 1.0)
             .add(&Quadric::plane(DVec3::Y, -2.0, 1.0))
