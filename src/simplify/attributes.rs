@@ -190,31 +190,38 @@ impl AttributeQuadrics {
         let (n, m) = (N, N - 3);
         let stride = n * (n + 1) / 2 + n + 1;
         debug_assert_eq!(stride, self.stride);
-        let mut q = [0.0; STRIDE_MAX];
-        for &w in wedges {
-            let base = w as usize * stride;
-            for (qi, d) in q[..stride].iter_mut().zip(&self.data[base..base + stride]) {
-                *qi += d;
-            }
-        }
         let off = n * (n + 1) / 2;
-        // Unpack the symmetric matrix once (the packed index arithmetic per access cost more than
-        // the solve).
-        let mut full = [[0.0f64; MAX_N]; MAX_N];
-        let mut k = 0;
+        // Sum the wedges' quadrics straight into the unpacked symmetric matrix, b and c (the
+        // packed index arithmetic per access cost more than the solve; arrays sized by N so
+        // nothing larger is cleared per call).
+        let mut full = [[0.0f64; N]; N];
+        let mut bv = [0.0f64; N];
+        let mut c = 0.0f64;
+        for &w in wedges {
+            let d = &self.data[w as usize * stride..(w as usize + 1) * stride];
+            let mut k = 0;
+            for i in 0..n {
+                for j in i..n {
+                    full[i][j] += d[k];
+                    k += 1;
+                }
+            }
+            for i in 0..n {
+                bv[i] += d[off + i];
+            }
+            c += d[off + n];
+        }
         for i in 0..n {
-            for j in i..n {
-                full[i][j] = q[k];
-                full[j][i] = q[k];
-                k += 1;
+            for j in 0..i {
+                full[i][j] = full[j][i];
             }
         }
         let a = |i: usize, j: usize| full[i][j];
         // Solve A_aa · a = −(A_ax · x + b_a) by Cholesky.
-        let mut l = [[0.0f64; MAX_M]; MAX_M];
-        let mut rhs = [0.0f64; MAX_M];
+        let mut l = [[0.0f64; N]; N];
+        let mut rhs = [0.0f64; N];
         for i in 0..m {
-            rhs[i] = -(a(3 + i, 0) * x.x + a(3 + i, 1) * x.y + a(3 + i, 2) * x.z + q[off + 3 + i]);
+            rhs[i] = -(a(3 + i, 0) * x.x + a(3 + i, 1) * x.y + a(3 + i, 2) * x.z + bv[3 + i]);
         }
         let mut ok = true;
         let trace: f64 = (0..m).map(|i| a(3 + i, 3 + i)).sum();
@@ -238,10 +245,10 @@ impl AttributeQuadrics {
                 break;
             }
         }
-        let mut v = [0.0; MAX_N];
+        let mut v = [0.0; N];
         v[..3].copy_from_slice(&x.to_array());
         if ok {
-            let mut y = [0.0; MAX_M];
+            let mut y = [0.0; N];
             for i in 0..m {
                 let mut s = rhs[i];
                 for k in 0..i {
@@ -260,10 +267,10 @@ impl AttributeQuadrics {
             self.attrs_into(keep, &mut v[3..]);
         }
         // Value at v.
-        let mut val = q[off + n];
+        let mut val = c;
         for i in 0..n {
             let row: f64 = (0..n).map(|j| full[i][j] * v[j]).sum();
-            val += v[i] * (row + 2.0 * q[off + i]);
+            val += v[i] * (row + 2.0 * bv[i]);
         }
         (self.wedge_from(&v[3..], keep), val.max(0.0))
     }
