@@ -461,6 +461,34 @@ impl LoadArgs {
 }
 
 /// Write a value to stdout as pretty JSON with a trailing newline.
+
+/// Tell the user (stderr) when a LOD stopped well above its triangle goal: the simplifier ran out
+/// of collapses it may make, and the file holds less simplification than asked for.
+fn warn_short_of_goals(
+    rows: &[lodeval::commands::SimplifyRow],
+    goals: &[lodeval::simplify::Goal],
+    method: &str,
+) {
+    use lodeval::simplify::Goal;
+    for (r, g) in rows.iter().zip(goals) {
+        let input = r.triangles as f64 / r.ratio.max(f64::MIN_POSITIVE);
+        let target = match *g {
+            Goal::Ratio(x) => (x * input).round(),
+            Goal::Triangles(n) => n as f64,
+            Goal::Error(_) => continue,
+        };
+        if r.triangles as f64 > 1.05 * target + 2.0 {
+            eprintln!(
+                "warning: {}: {method} stopped at {} triangles, short of the goal of {target}: no \
+                 further collapse keeps the surface intact (non-manifold edges and the vertices on \
+                 them never move; border vertices move only along the border). Repair the mesh, \
+                 or try another --method.",
+                r.file.display(),
+                r.triangles
+            );
+        }
+    }
+}
 fn emit_json<T: serde::Serialize>(value: &T) -> Result<(), Error> {
     let json = serde_json::to_string_pretty(value).map_err(|e| Error::Internal(e.to_string()))?;
     emit(&(json + "\n"))
@@ -846,9 +874,10 @@ fn run(cli: Cli) -> Result<(), Error> {
                 out: a.out.expect("clap requires it"),
                 method,
                 chain: !a.chain.is_empty(),
-                goals,
+                goals: goals.clone(),
             };
             let rows = lodeval::commands::simplify(&job)?;
+            warn_short_of_goals(&rows, &goals, method.name());
             if a.json {
                 return emit_json(&rows);
             }

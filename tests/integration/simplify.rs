@@ -157,3 +157,58 @@ fn eval_generates_qem_and_cluster_chains_with_geometric_columns() {
         assert!(h[0] < h[1], "{method}: {h:?}");
     }
 }
+
+#[test]
+fn a_goal_the_simplifier_cannot_reach_is_reported() {
+    // A 3×3 grid whose every triangle is doubled back to back: every edge has four triangles, so
+    // every vertex is non-manifold and QEM may not move any. The LOD is written (the input
+    // unchanged) and stderr says the goal was not reached and what to do.
+    let dir = tempfile::tempdir().unwrap();
+    let src = dir.path().join("doubled.obj");
+    let mut obj = String::new();
+    for y in 0..4 {
+        for x in 0..4 {
+            obj.push_str(&format!("v {x} {y} 0\n"));
+        }
+    }
+    for y in 0..3 {
+        for x in 0..3 {
+            let v = |dx: u32, dy: u32| (y + dy) * 4 + x + dx + 1;
+            let (a, b, c, d) = (v(0, 0), v(1, 0), v(1, 1), v(0, 1));
+            for [p, q, r] in [[a, b, c], [a, c, d]] {
+                obj.push_str(&format!("f {p} {q} {r}\nf {p} {r} {q}\n"));
+            }
+        }
+    }
+    std::fs::write(&src, obj).unwrap();
+    let out = dir.path().join("lod.obj");
+    let r = lodeval([
+        "simplify",
+        src.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+        "--method",
+        "qem",
+        "--ratio",
+        "0.25",
+    ]);
+    assert_eq!(r.code, 0, "{}", r.stderr);
+    assert!(
+        r.stderr.contains("short of the goal of 9") && r.stderr.contains("non-manifold"),
+        "{}",
+        r.stderr
+    );
+    // A reachable goal gives no warning.
+    let r = lodeval([
+        "simplify",
+        model("spot/spot_mtl.obj").to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+        "--method",
+        "qem",
+        "--ratio",
+        "0.25",
+    ]);
+    assert_eq!(r.code, 0, "{}", r.stderr);
+    assert!(!r.stderr.contains("warning"), "{}", r.stderr);
+}
