@@ -460,8 +460,6 @@ impl LoadArgs {
     }
 }
 
-/// Write a value to stdout as pretty JSON with a trailing newline.
-
 /// Tell the user (stderr) when a LOD stopped well above its triangle goal: the simplifier ran out
 /// of collapses it may make, and the file holds less simplification than asked for.
 fn warn_short_of_goals(
@@ -489,6 +487,8 @@ fn warn_short_of_goals(
         }
     }
 }
+
+/// Write a value to stdout as pretty JSON with a trailing newline.
 fn emit_json<T: serde::Serialize>(value: &T) -> Result<(), Error> {
     let json = serde_json::to_string_pretty(value).map_err(|e| Error::Internal(e.to_string()))?;
     emit(&(json + "\n"))
