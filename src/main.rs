@@ -477,10 +477,10 @@ fn warn_short_of_goals(
         };
         if r.triangles as f64 > 1.05 * target + 2.0 {
             eprintln!(
-                "warning: {}: {method} stopped at {} triangles, short of the goal of {target}: no \
-                 further collapse keeps the surface intact (non-manifold edges and the vertices on \
-                 them never move; border vertices move only along the border). Repair the mesh, \
-                 or try another --method.",
+                "warning: {}: {method} stopped at {} triangles, short of the goal of {target}: \
+                 every remaining collapse would change the surface's topology or fold it over \
+                 (closed parts are not collapsed away, borders only shrink along themselves). Ask \
+                 for less reduction, or try another --method.",
                 r.file.display(),
                 r.triangles
             );

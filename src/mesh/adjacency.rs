@@ -19,6 +19,14 @@
 //!   collapsed along itself, never torn).
 //! - Locked and non-manifold vertices never move; an edge with more than two triangles is never
 //!   collapsed.
+//! - Except after [`Adjacency::allow_non_manifold_collapses`] (what QEM simplification does):
+//!   then a collapse that involves a non-manifold vertex may move it, may be along an edge with
+//!   more than two triangles, and skips the link condition — the surface there is not a manifold
+//!   to protect. Scans often carry such parts (the Stanford dragon's reconstruction has 2 534
+//!   edges with four or more triangles, from back-to-back duplicate faces and fins); with them
+//!   fixed, QEM stopped at 5 % of the dragon when asked for 1 %. The structure's invariants
+//!   ([`Adjacency::check`]) hold either way: triangles on the collapsed edge die, and every edge
+//!   that gains triangles ends at the merged vertex, which becomes non-manifold itself.
 
 use glam::{Vec2, Vec3};
 use smallvec::SmallVec;
@@ -47,7 +55,8 @@ pub enum VertexClass {
     Seam,
     /// On a border edge (one incident triangle).
     Border,
-    /// On an edge with more than two triangles: never moved.
+    /// On an edge with more than two triangles: never moved, unless non-manifold collapses are
+    /// allowed.
     NonManifold,
 }
 
@@ -77,7 +86,10 @@ pub struct Adjacency {
     alive: Vec<bool>,
     vtris: Vec<Vec<u32>>,
     class: Vec<VertexClass>,
+    /// Explicitly locked vertices ([`Adjacency::lock`]).
     locked: Vec<bool>,
+    /// Whether collapses may move non-manifold vertices ([`Adjacency::allow_non_manifold_collapses`]).
+    non_manifold_collapses: bool,
     /// The vertex's wedge if it had a single one when it was made, else [`SEVERAL`]. Operations
     /// never give a vertex a wedge it did not have (a collapse maps a's wedges onto b's, a swap or
     /// split keeps each vertex's wedges), so it still has exactly that one: the wedge look-ups
@@ -144,6 +156,7 @@ impl Adjacency {
             class: vec![VertexClass::Interior; positions.len()],
             locked: vec![false; positions.len()],
             only_wedge: Vec::new(),
+            non_manifold_collapses: false,
             materials: mesh.material_ids().to_vec(),
             positions,
             wedges,
@@ -182,11 +195,6 @@ impl Adjacency {
             for v in [*a, *b] {
                 let cur = &mut self.class[v as usize];
                 *cur = (*cur).max(c);
-            }
-        }
-        for v in 0..self.positions.len() {
-            if self.class[v] == VertexClass::NonManifold {
-                self.locked[v] = true;
             }
         }
     }
@@ -285,9 +293,17 @@ impl Adjacency {
         self.locked[v as usize] = true;
     }
 
-    /// Whether `v` may move.
+    /// Let collapses move non-manifold vertices and pass through non-manifold edges (module
+    /// docs). Replays of a collapse record must be made on a structure with the same setting.
+    pub fn allow_non_manifold_collapses(&mut self) {
+        self.non_manifold_collapses = true;
+    }
+
+    /// Whether `v` may not move: locked, or non-manifold while non-manifold collapses are not
+    /// allowed.
     pub fn is_locked(&self, v: u32) -> bool {
         self.locked[v as usize]
+            || (self.class[v as usize] == VertexClass::NonManifold && !self.non_manifold_collapses)
     }
 
     /// A vertex's class.
@@ -438,17 +454,24 @@ impl Adjacency {
         if shared.is_empty() {
             return Err(Reject::NoSuchEdge);
         }
-        if shared.len() > 2 {
+        // Where the surface is not a manifold (and that may be collapsed), there is no manifold
+        // to protect: edges with more triangles may collapse and the link condition is skipped.
+        let non_manifold = self.non_manifold_collapses
+            && (self.class[a as usize] == VertexClass::NonManifold
+                || self.class[b as usize] == VertexClass::NonManifold);
+        if shared.len() > 2 && !non_manifold {
             return Err(Reject::Link);
         }
-        if self.locked[a as usize] || (self.locked[b as usize] && p != self.positions[b as usize]) {
+        if self.is_locked(a) || (self.is_locked(b) && p != self.positions[b as usize]) {
             return Err(Reject::Locked);
         }
         // Link condition.
-        let (na, nb) = (self.neighbours(a), self.neighbours(b));
-        let common = na.iter().filter(|x| nb.binary_search(x).is_ok()).count();
-        if common != shared.len() {
-            return Err(Reject::Link);
+        if !non_manifold {
+            let (na, nb) = (self.neighbours(a), self.neighbours(b));
+            let common = na.iter().filter(|x| nb.binary_search(x).is_ok()).count();
+            if common != shared.len() {
+                return Err(Reject::Link);
+            }
         }
         // Two border vertices joined through the interior would pinch the surface.
         if shared.len() == 2
@@ -666,7 +689,7 @@ impl Adjacency {
             return Err(Reject::Seam);
         }
         let w = |t: u32, v: u32| self.corner_wedge(t, v);
-        if self.locked[a as usize] || self.locked[b as usize] {
+        if self.is_locked(a) || self.is_locked(b) {
             return Err(Reject::Locked);
         }
         let new1 = [a, d, c];
@@ -854,6 +877,20 @@ mod tests {
         Mesh::new(data, &crate::mesh::LoadOptions::DEFAULT).unwrap()
     }
 
+    /// An icosphere with every fifth face doubled back to back (non-manifold edges, as in scans).
+    fn with_fins() -> Mesh {
+        let mut data = shapes::icosphere(2).to_data();
+        let extra: Vec<[u32; 3]> = data
+            .triangles
+            .iter()
+            .step_by(5)
+            .map(|&[a, b, c]| [a, c, b])
+            .collect();
+        data.triangles.extend(extra);
+        data.material_ids.clear();
+        Mesh::new(data, &crate::mesh::LoadOptions::DEFAULT).unwrap()
+    }
+
     #[test]
     fn collapse_and_undo_restore_exactly() {
         let m = shapes::icosphere(2);
@@ -899,13 +936,24 @@ mod tests {
         #![proptest_config(ProptestConfig::with_cases(64))]
         #[test]
         fn random_operations_keep_the_invariants(
-            seams in any::<bool>(),
+            kind in 0u8..3,
             ops in proptest::collection::vec((0u8..3, 0usize..10_000, any::<bool>()), 1..60),
         ) {
             // A closed sphere (smooth, or a cube whose faces meet at normal seams) stays closed and
             // manifold under any accepted operation, and undoing an operation restores the state.
-            let m = if seams { faceted_cube() } else { shapes::icosphere(2) };
+            // A sphere with back-to-back duplicate faces, with non-manifold collapses allowed, keeps
+            // the structure's invariants.
+            let seams = kind == 1;
+            let m = match kind {
+                0 => shapes::icosphere(2),
+                1 => faceted_cube(),
+                _ => with_fins(),
+            };
             let mut adj = Adjacency::new(&m);
+            if kind == 2 {
+                prop_assert!(adj.non_manifold_edges() > 0);
+                adj.allow_non_manifold_collapses();
+            }
             let several = (0..adj.positions.len() as u32).filter(|&v| adj.vertex_wedges(v).len() > 1);
             prop_assert_eq!(several.count() > 0, seams);
             for (op, pick, keep) in ops {
@@ -936,8 +984,10 @@ mod tests {
                 };
                 if let Ok(undo) = result {
                     prop_assert!(adj.check().is_ok(), "{:?}", adj.check());
-                    prop_assert_eq!(adj.border_edges(), 0);
-                    prop_assert_eq!(adj.non_manifold_edges(), 0);
+                    if kind < 2 {
+                        prop_assert_eq!(adj.border_edges(), 0);
+                        prop_assert_eq!(adj.non_manifold_edges(), 0);
+                    }
                     if !keep {
                         adj.undo(undo);
                         prop_assert_eq!(&adj.tris, &snapshot.0);
