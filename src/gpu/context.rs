@@ -43,9 +43,18 @@ pub struct Gpu {
     pub(crate) device: wgpu::Device,
     pub(crate) queue: wgpu::Queue,
     pub(crate) info: AdapterInfo,
+    /// The renderer's pipelines, built on first use and shared by every scene.
+    render_pipelines: std::sync::OnceLock<super::render::Pipelines>,
 }
 
 impl Gpu {
+    /// The renderer's pipelines (compiled on the first call; the shaders depend only on the
+    /// device, so every scene uses the same ones).
+    pub(crate) fn render_pipelines(&self) -> &super::render::Pipelines {
+        self.render_pipelines
+            .get_or_init(|| super::render::build_pipelines(self))
+    }
+
     /// Open the best adapter. `Err(Error::Usage(NO_ADAPTER…))` when there is none.
     pub fn new() -> Result<Arc<Gpu>> {
         let mut desc = wgpu::InstanceDescriptor::new_without_display_handle();
@@ -87,6 +96,7 @@ impl Gpu {
             device,
             queue,
             info,
+            render_pipelines: std::sync::OnceLock::new(),
         }))
     }
 

@@ -102,9 +102,11 @@ struct Jitter {
     pad: [f32; 2],
 }
 
-/// The visibility pipelines (with and without back-face culling) and the shading pipeline.
+/// The visibility pipelines (with and without back-face culling) and the shading pipeline. They
+/// depend only on the device: built once per [`Gpu`] ([`Gpu::render_pipelines`]) and shared by
+/// every scene (eval uploads one scene per LOD).
 #[derive(Debug)]
-struct Pipelines {
+pub(crate) struct Pipelines {
     visibility: wgpu::RenderPipeline,
     visibility_culled: wgpu::RenderPipeline,
     shade: wgpu::ComputePipeline,
@@ -124,7 +126,6 @@ pub struct GpuScene {
     lights: Vec<crate::scene::Light>,
     ambient: f32,
     background: Vec3,
-    pipelines: Pipelines,
 }
 
 impl GpuScene {
@@ -247,7 +248,6 @@ impl GpuScene {
             lights: scene.lights.clone(),
             ambient: scene.ambient,
             background: scene.background,
-            pipelines: build_pipelines(&gpu),
             gpu,
         })
     }
@@ -267,6 +267,7 @@ impl GpuScene {
 
     fn render_unchecked(&self, camera: &Camera, settings: &RenderSettings) -> Result<Frame> {
         let gpu = &self.gpu;
+        let pipelines = gpu.render_pipelines();
         let (w, h) = (settings.width, settings.height);
         let limits = gpu.device.limits();
         let offsets = settings.samples.offsets();
@@ -349,9 +350,9 @@ impl GpuScene {
             })
         };
         let visibility = if settings.cull_backfaces {
-            &self.pipelines.visibility_culled
+            &pipelines.visibility_culled
         } else {
-            &self.pipelines.visibility
+            &pipelines.visibility
         };
         let mut encoder = gpu.encoder();
         // Stage 1: one visibility pass per sample.
@@ -435,7 +436,7 @@ impl GpuScene {
         ]);
         gpu.dispatch(
             &mut encoder,
-            &self.pipelines.shade,
+            &pipelines.shade,
             &resources,
             [w.div_ceil(8), h.div_ceil(8), 1],
         );
@@ -458,7 +459,7 @@ impl GpuScene {
 }
 
 /// The visibility pipelines and the shading pipeline.
-fn build_pipelines(gpu: &Gpu) -> Pipelines {
+pub(crate) fn build_pipelines(gpu: &Gpu) -> Pipelines {
     let device = &gpu.device;
     let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
         label: Some("visibility.wgsl"),
