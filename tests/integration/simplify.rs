@@ -250,3 +250,50 @@ fn qem_simplifies_through_non_manifold_parts() {
     assert!(rows[0]["triangles"].as_u64().unwrap() <= 12, "{}", r.stdout);
     assert!(!r.stderr.contains("warning"), "{}", r.stderr);
 }
+
+#[test]
+fn qem_reaches_its_goal_on_the_non_manifold_dragon_scan() {
+    // The shipped Stanford dragon (res4, 11 102 triangles) has non-manifold edges from its
+    // reconstruction. QEM used to stop at 25 % when asked for 2 %; it must reach the goal, with a
+    // measured mean surface distance no larger than meshoptimizer's at the same goal.
+    let dir = tempfile::tempdir().unwrap();
+    let src = model("dragon/dragon_vrip_res4.ply");
+    let mean = |method: &str| {
+        let out = dir.path().join(format!("{method}.obj"));
+        let r = lodeval([
+            "simplify",
+            src.to_str().unwrap(),
+            "-o",
+            out.to_str().unwrap(),
+            "--method",
+            method,
+            "--ratio",
+            "0.02",
+            "--json",
+        ]);
+        assert_eq!(r.code, 0, "{method}: {}", r.stderr);
+        assert!(!r.stderr.contains("warning"), "{method}: {}", r.stderr);
+        let rows: serde_json::Value = serde_json::from_str(&r.stdout).unwrap();
+        let t = rows[0]["triangles"].as_u64().unwrap();
+        assert!(
+            (200..=235).contains(&t),
+            "{method}: {t} triangles for a goal of 222"
+        );
+        let g = lodeval([
+            "geometry",
+            src.to_str().unwrap(),
+            out.to_str().unwrap(),
+            "--samples",
+            "50000",
+            "--json",
+        ]);
+        assert_eq!(g.code, 0, "{}", g.stderr);
+        let d: serde_json::Value = serde_json::from_str(&g.stdout).unwrap();
+        d["mean_relative"].as_f64().unwrap()
+    };
+    let (qem, meshopt) = (mean("qem"), mean("meshopt"));
+    assert!(
+        qem <= meshopt,
+        "QEM mean {qem} above meshoptimizer's {meshopt}"
+    );
+}
