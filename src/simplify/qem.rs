@@ -559,17 +559,22 @@ mod tests {
         }
     }
 
+    /// The shipped Spot (UV seams: several wedges per vertex).
+    fn spot() -> Mesh {
+        crate::mesh::load(
+            &std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+                .join("reference/models/spot/spot_mtl.obj"),
+            &LoadOptions::default(),
+        )
+        .unwrap()
+    }
+
     #[test]
     fn seams_are_not_torn() {
         // Spot has UV seams; after simplification every position still has, for each of its
         // corners, a UV that came from a wedge of the original seam structure: the number of
         // border edges (seen on the welded mesh) stays zero.
-        let spot = crate::mesh::load(
-            &std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-                .join("reference/models/spot/spot_mtl.obj"),
-            &LoadOptions::default(),
-        )
-        .unwrap();
+        let spot = spot();
         let (lod, _) = simplify(&spot, Stop::Triangles(spot.triangle_count() / 4)).unwrap();
         let adj = Adjacency::new(&lod);
         assert_eq!(adj.border_edges(), 0, "a seam opened into a hole");
@@ -581,12 +586,7 @@ mod tests {
     fn the_collapse_sequence_does_not_depend_on_the_thread_count() {
         // The first edge costs are evaluated in parallel; the queue's total order makes the
         // sequence the same for any pool size (Spot: UV seams, so several wedges per vertex).
-        let spot = crate::mesh::load(
-            &std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-                .join("reference/models/spot/spot_mtl.obj"),
-            &LoadOptions::default(),
-        )
-        .unwrap();
+        let spot = spot();
         let run_with = |threads: usize| {
             let pool = rayon::ThreadPoolBuilder::new()
                 .num_threads(threads)

@@ -51,20 +51,8 @@ impl<T: Ord + Copy> MinQueue<T> {
         let top = self.items[0];
         // Floyd: move the smaller child up until the hole reaches a leaf, then put `last` there
         // and sift it up (it usually stays near the bottom).
-        let n = self.items.len();
         let mut hole = 0;
-        loop {
-            let first = D * hole + 1;
-            if first >= n {
-                break;
-            }
-            let end = (first + D).min(n);
-            let mut best = first;
-            for c in first + 1..end {
-                if self.items[c] < self.items[best] {
-                    best = c;
-                }
-            }
+        while let Some(best) = self.smallest_child(hole) {
             self.items[hole] = self.items[best];
             hole = best;
         }
@@ -94,20 +82,8 @@ impl<T: Ord + Copy> MinQueue<T> {
     }
 
     fn sift_down(&mut self, mut i: usize) {
-        let n = self.items.len();
         let x = self.items[i];
-        loop {
-            let first = D * i + 1;
-            if first >= n {
-                break;
-            }
-            let end = (first + D).min(n);
-            let mut best = first;
-            for c in first + 1..end {
-                if self.items[c] < self.items[best] {
-                    best = c;
-                }
-            }
+        while let Some(best) = self.smallest_child(i) {
             if x <= self.items[best] {
                 break;
             }
@@ -115,6 +91,23 @@ impl<T: Ord + Copy> MinQueue<T> {
             i = best;
         }
         self.items[i] = x;
+    }
+
+    /// The index of node `i`'s smallest child, if it has children.
+    #[inline(always)]
+    fn smallest_child(&self, i: usize) -> Option<usize> {
+        let n = self.items.len();
+        let first = D * i + 1;
+        if first >= n {
+            return None;
+        }
+        let mut best = first;
+        for c in first + 1..(first + D).min(n) {
+            if self.items[c] < self.items[best] {
+                best = c;
+            }
+        }
+        Some(best)
     }
 }
 
