@@ -239,11 +239,16 @@ impl Adjacency {
     /// [`Adjacency::collapse_wedge_map`] for an `a`, `b` known to be an edge: two single-wedge
     /// vertices pair their wedges without a look at the triangles.
     pub fn edge_wedge_map(&self, a: u32, b: u32) -> Result<WedgeMap, Reject> {
-        let (wa, wb) = (self.only_wedge[a as usize], self.only_wedge[b as usize]);
-        if wa != SEVERAL && wb != SEVERAL {
-            return Ok(SmallVec::from_slice(&[(wa, wb)]));
+        match self.single_wedges(a, b) {
+            Some(pair) => Ok(SmallVec::from_slice(&[pair])),
+            None => self.collapse_wedge_map(a, b),
         }
-        self.collapse_wedge_map(a, b)
+    }
+
+    /// The wedges of `a` and `b` when each has a single one.
+    fn single_wedges(&self, a: u32, b: u32) -> Option<(u32, u32)> {
+        let (wa, wb) = (self.only_wedge[a as usize], self.only_wedge[b as usize]);
+        (wa != SEVERAL && wb != SEVERAL).then_some((wa, wb))
     }
 
     /// The wedge of `v`'s corner in triangle `t` (which must use `v`).
@@ -496,10 +501,9 @@ impl Adjacency {
     /// For each wedge of `a`, its partner wedge of `b` across the edge.
     fn wedge_map(&self, a: u32, b: u32, shared: &[u32]) -> Result<WedgeMap, Reject> {
         let mut map = WedgeMap::new();
-        let (wa, wb) = (self.only_wedge[a as usize], self.only_wedge[b as usize]);
-        if wa != SEVERAL && wb != SEVERAL {
+        if let Some(pair) = self.single_wedges(a, b) {
             // One wedge each: every shared triangle pairs the same two.
-            map.push((wa, wb));
+            map.push(pair);
             return Ok(map);
         }
         for &t in shared {
