@@ -579,6 +579,8 @@ pub struct SimplifyJob {
     pub goals: Vec<crate::simplify::Goal>,
     /// Write one file per goal with a suffix (a chain) rather than `out` itself.
     pub chain: bool,
+    /// Show a spinner on stderr while simplifying (large meshes take seconds).
+    pub progress: bool,
 }
 
 /// One written LOD.
@@ -611,7 +613,17 @@ fn load_for_lod(input: &Path, out: &Path) -> Result<Mesh> {
 pub fn simplify(job: &SimplifyJob) -> Result<Vec<SimplifyRow>> {
     let mesh = load_for_lod(&job.mesh, &job.out)?;
     let start = std::time::Instant::now();
-    let lods = crate::simplify::chain(&mesh, job.method, &job.goals)?;
+    let spinner = crate::eval::run::spinner(
+        job.progress,
+        format!(
+            "simplifying {} triangles with {}",
+            mesh.triangle_count(),
+            job.method.name()
+        ),
+    );
+    let lods = crate::simplify::chain(&mesh, job.method, &job.goals);
+    spinner.finish_and_clear();
+    let lods = lods?;
     let seconds = start.elapsed().as_secs_f64();
     let stem = job
         .out

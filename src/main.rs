@@ -875,6 +875,7 @@ fn run(cli: Cli) -> Result<(), Error> {
                 method,
                 chain: !a.chain.is_empty(),
                 goals: goals.clone(),
+                progress: !cli.quiet && std::io::IsTerminal::is_terminal(&std::io::stderr()),
             };
             let rows = lodeval::commands::simplify(&job)?;
             warn_short_of_goals(&rows, &goals, method.name());

@@ -391,6 +391,22 @@ fn thumbnail(img: &image::RgbImage) -> image::RgbImage {
     image::imageops::resize(img, THUMB, THUMB, image::imageops::FilterType::Triangle)
 }
 
+/// A spinner with a message and the elapsed time, for work without a count; hidden when not
+/// `enabled`.
+pub(crate) fn spinner(enabled: bool, message: String) -> indicatif::ProgressBar {
+    if !enabled {
+        return indicatif::ProgressBar::hidden();
+    }
+    let bar = indicatif::ProgressBar::new_spinner().with_message(message);
+    if let Ok(style) =
+        indicatif::ProgressStyle::with_template("{spinner} [{elapsed_precise}] {msg}")
+    {
+        bar.set_style(style);
+    }
+    bar.enable_steady_tick(std::time::Duration::from_millis(120));
+    bar
+}
+
 /// A progress bar counting `unit`s, or a hidden one when not `enabled`.
 pub(crate) fn progress_bar(enabled: bool, len: u64, unit: &str) -> indicatif::ProgressBar {
     if !enabled {
