@@ -1,7 +1,21 @@
 //! `lodeval simplify` and `lodeval geometry` end to end, and the eval generators `qem` and
 //! `cluster`.
 
-use crate::common::{lodeval, model};
+use std::path::Path;
+
+use crate::common::{Run, lodeval, model};
+
+/// `lodeval simplify SRC -o OUT` with `args` after them.
+fn simplify(src: &Path, out: &Path, args: &[&str]) -> Run {
+    let mut all = vec![
+        "simplify",
+        src.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+    ];
+    all.extend_from_slice(args);
+    lodeval(all)
+}
 
 #[test]
 fn simplify_writes_loadable_lods_with_every_method() {
@@ -9,17 +23,11 @@ fn simplify_writes_loadable_lods_with_every_method() {
     let src = model("spot/spot_mtl.obj");
     for method in ["qem", "cluster", "meshopt"] {
         let out = dir.path().join(format!("{method}.obj"));
-        let r = lodeval([
-            "simplify",
-            src.to_str().unwrap(),
-            "-o",
-            out.to_str().unwrap(),
-            "--method",
-            method,
-            "--triangles",
-            "1000",
-            "--json",
-        ]);
+        let r = simplify(
+            &src,
+            &out,
+            &["--method", method, "--triangles", "1000", "--json"],
+        );
         assert_eq!(r.code, 0, "{method}: {}", r.stderr);
         let rows: serde_json::Value = serde_json::from_str(&r.stdout).unwrap();
         let t = rows[0]["triangles"].as_u64().unwrap();
@@ -37,14 +45,7 @@ fn simplify_writes_loadable_lods_with_every_method() {
     }
     // A chain writes one file per ratio.
     let out = dir.path().join("chain.obj");
-    let r = lodeval([
-        "simplify",
-        src.to_str().unwrap(),
-        "-o",
-        out.to_str().unwrap(),
-        "--chain",
-        "0.5,0.1",
-    ]);
+    let r = simplify(&src, &out, &["--chain", "0.5,0.1"]);
     assert_eq!(r.code, 0, "{}", r.stderr);
     assert!(dir.path().join("chain-r50.obj").exists() && dir.path().join("chain-r10.obj").exists());
 }
@@ -77,14 +78,7 @@ fn geometry_reports_zero_for_a_copy_and_the_json_keys() {
     let dir = tempfile::tempdir().unwrap();
     let a = model("bunny/bunny_odedstein_3k.obj");
     let lod = dir.path().join("lod.obj");
-    let r = lodeval([
-        "simplify",
-        a.to_str().unwrap(),
-        "-o",
-        lod.to_str().unwrap(),
-        "--ratio",
-        "0.25",
-    ]);
+    let r = simplify(&a, &lod, &["--ratio", "0.25"]);
     assert_eq!(r.code, 0, "{}", r.stderr);
     let r = lodeval([
         "geometry",
@@ -177,16 +171,7 @@ fn a_goal_the_simplifier_cannot_reach_is_reported() {
     }
     std::fs::write(&src, obj).unwrap();
     let out = dir.path().join("lod.obj");
-    let r = lodeval([
-        "simplify",
-        src.to_str().unwrap(),
-        "-o",
-        out.to_str().unwrap(),
-        "--method",
-        "qem",
-        "--ratio",
-        "0.1",
-    ]);
+    let r = simplify(&src, &out, &["--method", "qem", "--ratio", "0.1"]);
     assert_eq!(r.code, 0, "{}", r.stderr);
     assert!(
         r.stderr
@@ -197,16 +182,11 @@ fn a_goal_the_simplifier_cannot_reach_is_reported() {
     );
     assert!(out.exists());
     // A reachable goal gives no warning.
-    let r = lodeval([
-        "simplify",
-        model("spot/spot_mtl.obj").to_str().unwrap(),
-        "-o",
-        out.to_str().unwrap(),
-        "--method",
-        "qem",
-        "--ratio",
-        "0.25",
-    ]);
+    let r = simplify(
+        &model("spot/spot_mtl.obj"),
+        &out,
+        &["--method", "qem", "--ratio", "0.25"],
+    );
     assert_eq!(r.code, 0, "{}", r.stderr);
     assert!(!r.stderr.contains("warning"), "{}", r.stderr);
 }
@@ -234,17 +214,11 @@ fn qem_simplifies_through_non_manifold_parts() {
     }
     std::fs::write(&src, obj).unwrap();
     let out = dir.path().join("lod.obj");
-    let r = lodeval([
-        "simplify",
-        src.to_str().unwrap(),
-        "-o",
-        out.to_str().unwrap(),
-        "--method",
-        "qem",
-        "--triangles",
-        "12",
-        "--json",
-    ]);
+    let r = simplify(
+        &src,
+        &out,
+        &["--method", "qem", "--triangles", "12", "--json"],
+    );
     assert_eq!(r.code, 0, "{}", r.stderr);
     let rows: serde_json::Value = serde_json::from_str(&r.stdout).unwrap();
     assert!(rows[0]["triangles"].as_u64().unwrap() <= 12, "{}", r.stdout);
@@ -260,17 +234,11 @@ fn qem_reaches_its_goal_on_the_non_manifold_dragon_scan() {
     let src = model("dragon/dragon_vrip_res4.ply");
     let mean = |method: &str| {
         let out = dir.path().join(format!("{method}.obj"));
-        let r = lodeval([
-            "simplify",
-            src.to_str().unwrap(),
-            "-o",
-            out.to_str().unwrap(),
-            "--method",
-            method,
-            "--ratio",
-            "0.02",
-            "--json",
-        ]);
+        let r = simplify(
+            &src,
+            &out,
+            &["--method", method, "--ratio", "0.02", "--json"],
+        );
         assert_eq!(r.code, 0, "{method}: {}", r.stderr);
         assert!(!r.stderr.contains("warning"), "{method}: {}", r.stderr);
         let rows: serde_json::Value = serde_json::from_str(&r.stdout).unwrap();
