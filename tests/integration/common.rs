@@ -29,6 +29,18 @@ where
     }
 }
 
+/// `lodeval simplify SRC -o OUT` with `args` after them.
+pub fn simplify(src: &Path, out: &Path, args: &[&str]) -> Run {
+    let mut all = vec![
+        "simplify",
+        src.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+    ];
+    all.extend_from_slice(args);
+    lodeval(all)
+}
+
 /// The repository root.
 pub fn root() -> &'static Path {
     Path::new(env!("CARGO_MANIFEST_DIR"))

@@ -11,16 +11,11 @@ fn run(
     let original = model("bunny/bunny_odedstein_3k.obj");
     let coarse = dir.join("coarse.obj");
     if !coarse.exists() {
-        let r = lodeval([
-            "simplify",
-            original.to_str().unwrap(),
-            "-o",
-            coarse.to_str().unwrap(),
-            "--method",
-            "cluster",
-            "--ratio",
-            "0.1",
-        ]);
+        let r = crate::common::simplify(
+            &original,
+            &coarse,
+            &["--method", "cluster", "--ratio", "0.1"],
+        );
         assert_eq!(r.code, 0, "{}", r.stderr);
     }
     let out = dir.join(out);

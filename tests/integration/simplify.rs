@@ -1,21 +1,7 @@
 //! `lodeval simplify` and `lodeval geometry` end to end, and the eval generators `qem` and
 //! `cluster`.
 
-use std::path::Path;
-
-use crate::common::{Run, lodeval, model};
-
-/// `lodeval simplify SRC -o OUT` with `args` after them.
-fn simplify(src: &Path, out: &Path, args: &[&str]) -> Run {
-    let mut all = vec![
-        "simplify",
-        src.to_str().unwrap(),
-        "-o",
-        out.to_str().unwrap(),
-    ];
-    all.extend_from_slice(args);
-    lodeval(all)
-}
+use crate::common::{lodeval, model, simplify};
 
 #[test]
 fn simplify_writes_loadable_lods_with_every_method() {

@@ -163,16 +163,11 @@ fn a_non_manifold_scan_gets_a_lod_within_budget() {
     // record, which now passes through them, so the replay must use the same rules.
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("w.obj");
-    let r = lodeval([
-        "simplify",
-        model("dragon/dragon_vrip_res4.ply").to_str().unwrap(),
-        "-o",
-        out.to_str().unwrap(),
-        "--method",
-        "williams",
-        "--budget",
-        "500",
-    ]);
+    let r = crate::common::simplify(
+        &model("dragon/dragon_vrip_res4.ply"),
+        &out,
+        &["--method", "williams", "--budget", "500"],
+    );
     assert_eq!(r.code, 0, "{}", r.stderr);
     let tris = std::fs::read_to_string(&out)
         .unwrap()
