@@ -113,7 +113,8 @@ impl Binned {
     /// overlap `rect` and the overlay, never by scanning all triangles.
     pub fn candidates(&self, rect: [i32; 4], width: u32, height: u32) -> Vec<u32> {
         let overlaps = |t: &SetupTri| {
-            t.bbox[0] < rect[2] && rect[0] < t.bbox[2] && t.bbox[1] < rect[3] && rect[1] < t.bbox[3]
+            let b = t.bbox();
+            b[0] < rect[2] && rect[0] < b[2] && b[1] < rect[3] && rect[1] < b[3]
         };
         let (tx0, ty0) = (rect[0] as u32 / TILE, rect[1] as u32 / TILE);
         let (tx1, ty1) = ((rect[2] as u32 - 1) / TILE, (rect[3] as u32 - 1) / TILE);
@@ -197,7 +198,7 @@ pub(crate) fn setup_and_bin(
             // Explicit loops: most triangles touch one tile, and nested iterator adapters here
             // cost more than the counting itself.
             let tile_range = |t: &SetupTri| {
-                let [x0, y0, x1, y1] = t.bbox;
+                let [x0, y0, x1, y1] = t.bbox();
                 [
                     x0 as u32 / TILE,
                     y0 as u32 / TILE,

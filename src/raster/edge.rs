@@ -74,10 +74,11 @@ pub(crate) fn rasterize(
     buf: &mut TileSamples,
     scratch: &mut [[i64; 3]],
 ) {
-    let x0 = st.bbox[0].max(clip[0]);
-    let y0 = st.bbox[1].max(clip[1]);
-    let x1 = st.bbox[2].min(clip[2]);
-    let y1 = st.bbox[3].min(clip[3]);
+    let bbox = st.bbox();
+    let x0 = bbox[0].max(clip[0]);
+    let y0 = bbox[1].max(clip[1]);
+    let x1 = bbox[2].min(clip[2]);
+    let y1 = bbox[3].min(clip[3]);
     if x0 >= x1 || y0 >= y1 {
         return;
     }
@@ -142,7 +143,7 @@ fn scan<const S: usize, const COUNT: bool>(
     let one = super::fixed::ONE_PIXEL;
     let s = if S == 0 { sample_off.len() } else { S };
     let sample_off = &sample_off[..s];
-    let inv_area = 1.0 / st.area as f64;
+    let inv_area = 1.0 / st.area() as f64;
     let z = st.z.map(|v| v as f64);
     let tile_w = (buf.rect[2] - buf.rect[0]) as usize;
     let mut row = origin;

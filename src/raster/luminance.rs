@@ -491,7 +491,7 @@ impl View {
                 for st in &tr.setup.tris {
                     let bary = super::setup::corner_barycentrics(st.corners, &tr.setup.clipped);
                     tr.pieces.push((t, Piece { st: *st, bary }));
-                    bb = Some(union(bb, st.bbox));
+                    bb = Some(union(bb, st.bbox()));
                 }
             }
             if let Some(b) = bb {
@@ -557,7 +557,7 @@ impl View {
                     }
                     tr.visited[tu] = number;
                     for (k, p) in self.pieces[tu].iter().enumerate() {
-                        if overlaps(p.st.bbox) {
+                        if overlaps(p.st.bbox()) {
                             let id = (t << PIECE_BITS) | k as u32;
                             edge::rasterize(&p.st, id, &offsets, h, samples, &mut scratch);
                         }

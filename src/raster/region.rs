@@ -83,7 +83,7 @@ impl RegionRenderer {
         // Old footprint of the changed triangles.
         for &t in changed {
             for id in self.pass.binned.ids_of(t) {
-                grow(self.pass.binned.get(id).bbox);
+                grow(self.pass.binned.get(id).bbox());
             }
         }
         // New vertex data: transform (and, for Gouraud, light) the vertices of changed triangles.
@@ -115,7 +115,7 @@ impl RegionRenderer {
                 setup_one(t, corners, xf, &planes, vp, out)
             });
             for id in self.pass.binned.ids_of(t) {
-                grow(self.pass.binned.get(id).bbox);
+                grow(self.pass.binned.get(id).bbox());
             }
         }
         if let Some(rect) = dirty {

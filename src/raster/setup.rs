@@ -6,7 +6,8 @@
 //! Conventions: screen x grows right, y grows down, pixel (x, y) covers [x, x+1) × [y, y+1) and its
 //! centre is (x + ½, y + ½). Front faces are counter-clockwise in NDC (OpenGL/glTF convention);
 //! in y-down screen space they have negative signed area under [`edge`](super::edge)'s edge function,
-//! so set-up swaps two corners of every front face to make all areas positive and records the facing.
+//! so set-up swaps two corners of every front face to make all areas positive (the corner code
+//! records the swap).
 
 use glam::{Mat4, Vec3, Vec4};
 use rayon::prelude::*;
@@ -16,30 +17,52 @@ use super::fixed::Fx24_8;
 
 /// A triangle ready for rasterization.
 ///
+/// The record is 64 bytes, one cache line: set-up writes one per visible triangle and the scan
+/// reads them back, so its size is the rasterizer's memory traffic (a 64-byte larger record
+/// doubled the set-up time of a 1M-triangle frame). Twice the area is recomputed from the corners
+/// rather than stored, and the box is stored in 16 bits ([`RenderSettings::MAX_SIZE`] < 2^16).
+///
 /// # Guarantees
-/// - `area > 0` (twice the signed area in Fx24_8² units, after reordering corners).
-/// - `bbox` is within the viewport and non-empty.
+/// - [`SetupTri::area`] > 0 (corners reordered to positive area).
+/// - [`SetupTri::bbox`] is within the viewport and non-empty.
+///
+/// [`RenderSettings::MAX_SIZE`]: super::RenderSettings::MAX_SIZE
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[repr(C, align(64))]
 pub(crate) struct SetupTri {
     /// Fixed-point screen positions.
     pub v: [[i32; 2]; 3],
-    /// Twice the area, > 0.
-    pub area: i64,
     /// NDC depth (0 near .. 1 far) per corner.
     pub z: [f32; 3],
     /// 1/w per corner (perspective-correct interpolation).
     pub inv_w: [f32; 3],
     /// Barycentrics of the corners with respect to the source triangle's vertices, coded (a
-    /// clipped corner set would triple the record, and the record's size is the rasterizer's
-    /// memory traffic): [`CORNERS_SOURCE`], [`CORNERS_SWAPPED`], or `CORNERS_CLIPPED + k` for
-    /// entry k of the owner's clipped-corner table ([`SetupOut::clipped`]).
+    /// clipped corner set would triple the record): [`CORNERS_SOURCE`], [`CORNERS_SWAPPED`], or
+    /// `CORNERS_CLIPPED + k` for entry k of the owner's clipped-corner table
+    /// ([`SetupOut::clipped`]).
     pub corners: u32,
     /// Source triangle index.
     pub tri: u32,
-    /// Whether the source triangle faces the camera.
-    pub front: bool,
     /// Covered pixel rectangle `[x0, y0, x1, y1)`.
-    pub bbox: [i32; 4],
+    bbox: [u16; 4],
+}
+
+const _: () = assert!(std::mem::size_of::<SetupTri>() == 64);
+const _: () = assert!(super::RenderSettings::MAX_SIZE <= u16::MAX as u32);
+
+impl SetupTri {
+    /// Twice the signed area in Fx24_8² units, > 0.
+    #[inline]
+    pub fn area(&self) -> i64 {
+        let [a, b, c] = self.v.map(|q| [q[0] as i64, q[1] as i64]);
+        (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0])
+    }
+
+    /// Covered pixel rectangle `[x0, y0, x1, y1)`.
+    #[inline]
+    pub fn bbox(&self) -> [i32; 4] {
+        self.bbox.map(i32::from)
+    }
 }
 
 /// The corners are the source triangle's vertices 0, 1, 2.
@@ -198,7 +221,7 @@ fn emit(
         (b[0] as i64 - a[0] as i64) * (p[1] as i64 - a[1] as i64)
             - (b[1] as i64 - a[1] as i64) * (p[0] as i64 - a[0] as i64)
     };
-    let mut area = e(v[0], v[1], v[2]);
+    let area = e(v[0], v[1], v[2]);
     if area == 0 {
         return;
     }
@@ -213,7 +236,6 @@ fn emit(
         if let Some(b) = bary.as_mut() {
             b.swap(1, 2);
         }
-        area = -area;
     }
     let min_x = v.iter().map(|p| p[0]).min().unwrap_or(0);
     let max_x = v.iter().map(|p| p[0]).max().unwrap_or(0);
@@ -246,12 +268,11 @@ fn emit(
     };
     out.tris.push(SetupTri {
         v,
-        area,
         z,
         inv_w,
         corners,
         tri: index,
-        front,
-        bbox,
+        // In range: 0 ≤ box ≤ the viewport size ≤ MAX_SIZE < 2^16.
+        bbox: bbox.map(|b| b as u16),
     });
 }

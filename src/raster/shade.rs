@@ -112,7 +112,7 @@ pub(crate) fn source_barycentrics(
     // Fixed-point corners in pixels; λ_i = E_i(x, y) / area (both in px²).
     let p =
         st.v.map(|q| [q[0] as f64 * (1.0 / 256.0), q[1] as f64 * (1.0 / 256.0)]);
-    let inv_area = 65536.0 / st.area as f64;
+    let inv_area = 65536.0 / st.area() as f64;
     let edge = |a: [f64; 2], b: [f64; 2]| {
         ((b[0] - a[0]) * (y - a[1]) - (b[1] - a[1]) * (x - a[0])) * inv_area
     };
