@@ -20,7 +20,7 @@ use glam::Vec3;
 
 use super::edge::{self, TileSamples};
 use super::frame::Frame;
-use super::resolve::{Pass, blit};
+use super::resolve::{Pass, frame_rect};
 use super::setup::{setup_one, transform_one};
 use super::{RenderSettings, Shading, rect_union, shade};
 use crate::error::{Error, Result};
@@ -151,7 +151,7 @@ impl RegionRenderer {
             );
         }
         let ctx = self.pass.context(Some(&self.vertex_light));
-        let resolved = self.pass.resolve(&ctx, &buf);
-        blit(&mut self.frame, &resolved);
+        self.pass
+            .resolve(&ctx, &buf, &mut frame_rect(&mut self.frame, rect));
     }
 }

@@ -33,14 +33,104 @@ pub(crate) struct Pass {
     depth_range: (f32, f32, bool),
 }
 
-/// Resolved pixels of a rectangle.
-#[derive(Debug)]
-pub(crate) struct Resolved {
-    rect: [i32; 4],
-    color: Vec<Vec3>,
-    depth: Vec<f32>,
-    coverage: Vec<f32>,
-    triangle: Vec<u32>,
+/// Where a resolve writes: one rectangle of a frame, as a row slice of every channel per pixel
+/// row, filled in row-major order.
+pub(crate) struct RectMut<'a> {
+    rows: Vec<RowMut<'a>>,
+    row: usize,
+    col: usize,
+}
+
+/// One pixel row of a [`RectMut`].
+struct RowMut<'a> {
+    color: &'a mut [Vec3],
+    depth: &'a mut [f32],
+    coverage: &'a mut [f32],
+    triangle: &'a mut [u32],
+}
+
+impl RectMut<'_> {
+    /// Write the next pixel.
+    #[inline]
+    fn push(&mut self, color: Vec3, depth: f32, coverage: f32, triangle: u32) {
+        let r = &mut self.rows[self.row];
+        let c = self.col;
+        (r.color[c], r.depth[c], r.coverage[c], r.triangle[c]) = (color, depth, coverage, triangle);
+        self.col += 1;
+        if self.col == r.color.len() {
+            (self.row, self.col) = (self.row + 1, 0);
+        }
+    }
+}
+
+/// The pixel rectangle `[x0, y0, x1, y1)` of `frame` as a resolve target.
+pub(crate) fn frame_rect(frame: &mut Frame, [x0, y0, x1, y1]: [i32; 4]) -> RectMut<'_> {
+    let w = frame.width as usize;
+    let (a, b) = (x0 as usize, x1 as usize);
+    let rows = frame
+        .color
+        .chunks_mut(w)
+        .zip(frame.depth.chunks_mut(w))
+        .zip(frame.coverage.chunks_mut(w))
+        .zip(frame.triangle.chunks_mut(w))
+        .skip(y0 as usize)
+        .take((y1 - y0) as usize)
+        .map(|(((color, depth), coverage), triangle)| RowMut {
+            color: &mut color[a..b],
+            depth: &mut depth[a..b],
+            coverage: &mut coverage[a..b],
+            triangle: &mut triangle[a..b],
+        })
+        .collect();
+    RectMut {
+        rows,
+        row: 0,
+        col: 0,
+    }
+}
+
+/// `frame` cut into the resolve targets of its `tile`×`tile` tiles, row-major tile order.
+fn frame_tiles(frame: &mut Frame, tile: usize) -> Vec<RectMut<'_>> {
+    let w = frame.width as usize;
+    let tiles_x = w.div_ceil(tile);
+    let n_tiles = tiles_x * (frame.height as usize).div_ceil(tile);
+    let mut tiles: Vec<RectMut> = (0..n_tiles)
+        .map(|_| RectMut {
+            rows: Vec::with_capacity(tile),
+            row: 0,
+            col: 0,
+        })
+        .collect();
+    let rows = frame
+        .color
+        .chunks_mut(w)
+        .zip(frame.depth.chunks_mut(w))
+        .zip(frame.coverage.chunks_mut(w))
+        .zip(frame.triangle.chunks_mut(w));
+    for (y, (((color, depth), coverage), triangle)) in rows.enumerate() {
+        let pieces = color
+            .chunks_mut(tile)
+            .zip(depth.chunks_mut(tile))
+            .zip(coverage.chunks_mut(tile))
+            .zip(triangle.chunks_mut(tile));
+        for (tx, (((color, depth), coverage), triangle)) in pieces.enumerate() {
+            tiles[y / tile * tiles_x + tx].rows.push(RowMut {
+                color,
+                depth,
+                coverage,
+                triangle,
+            });
+        }
+    }
+    tiles
+}
+
+/// A frame channel of `n` copies of `value`, written in parallel (a serial fill of the 12 MB
+/// colour channel of a 1024² frame was a visible share of a frame's time).
+fn filled<T: Copy + Send + Sync>(n: usize, value: T) -> Vec<T> {
+    let mut out = Vec::with_capacity(n);
+    out.par_extend(rayon::iter::repeat_n(value, n));
+    out
 }
 
 impl Pass {
@@ -121,19 +211,12 @@ impl Pass {
         buf
     }
 
-    /// Stage 4: resolve a sample buffer into pixels.
-    pub fn resolve(&self, ctx: &ShadeContext, buf: &TileSamples) -> Resolved {
+    /// Stage 4: resolve a sample buffer into pixels, written to `out` (its rectangle is
+    /// `buf.rect`).
+    pub fn resolve(&self, ctx: &ShadeContext, buf: &TileSamples, out: &mut RectMut) {
         let [x0, y0, x1, y1] = buf.rect;
-        let n = ((x1 - x0) * (y1 - y0)) as usize;
         let s = buf.samples;
         let bg = self.scene.background;
-        let mut out = Resolved {
-            rect: buf.rect,
-            color: Vec::with_capacity(n),
-            depth: Vec::with_capacity(n),
-            coverage: Vec::with_capacity(n),
-            triangle: Vec::with_capacity(n),
-        };
         // (set-up id, first sample, sample count) of the distinct triangles in one pixel.
         let mut groups: Vec<(u32, usize, usize)> = Vec::with_capacity(s);
         for y in y0..y1 {
@@ -153,10 +236,8 @@ impl Pass {
                             (ctx.shade(id, sx, sy), self.binned.get(id).tri)
                         }
                     };
-                    out.color.push(color);
-                    out.depth.push(buf.depth[base]);
-                    out.coverage.push(if id == EMPTY { 0.0 } else { 1.0 });
-                    out.triangle.push(tri);
+                    let coverage = if id == EMPTY { 0.0 } else { 1.0 };
+                    out.push(color, buf.depth[base], coverage, tri);
                     continue;
                 }
                 groups.clear();
@@ -191,57 +272,35 @@ impl Pass {
                         Some((_, c)) if c >= g.2 => acc,
                         _ => Some((g.0, g.2)),
                     });
-                out.color.push(color / s as f32);
-                out.depth.push(depth);
-                out.coverage.push((s - empty) as f32 / s as f32);
-                out.triangle
-                    .push(best.map_or(NO_TRIANGLE, |(id, _)| self.binned.get(id).tri));
+                out.push(
+                    color / s as f32,
+                    depth,
+                    (s - empty) as f32 / s as f32,
+                    best.map_or(NO_TRIANGLE, |(id, _)| self.binned.get(id).tri),
+                );
             }
         }
-        out
     }
 
-    /// Rasterize and resolve every tile (tiles in parallel), then copy each band of tile rows into
-    /// the frame (bands in parallel; every pixel written exactly once).
+    /// Rasterize and resolve every tile, in parallel, each straight into its pixels of the frame.
     pub fn resolve_frame(&self, ctx: &ShadeContext) -> Frame {
         let (w, h) = (self.settings.width as usize, self.settings.height as usize);
         let n = w * h;
-        let tiles: Vec<Resolved> = (0..self.binned.tile_count())
-            .into_par_iter()
-            .map(|t| self.resolve(ctx, &self.raster_tile(t)))
-            .collect();
-        // Every pixel is written below, so the buffers start as zeroed (calloc'd, untouched) pages
-        // rather than being filled with their "empty" values first.
+        // Every pixel is written by exactly one tile; the fill values are never seen.
         let mut frame = Frame {
             width: w as u32,
             height: h as u32,
-            color: vec![Vec3::ZERO; n],
-            depth: vec![0.0; n],
-            coverage: vec![0.0; n],
-            triangle: vec![0; n],
+            color: filled(n, Vec3::ZERO),
+            depth: filled(n, 0.0),
+            coverage: filled(n, 0.0),
+            triangle: filled(n, 0),
         };
-        let band = bin::TILE as usize * w;
-        let tiles_x = (w as u32).div_ceil(bin::TILE) as usize;
-        frame
-            .color
-            .par_chunks_mut(band)
-            .zip(frame.depth.par_chunks_mut(band))
-            .zip(frame.coverage.par_chunks_mut(band))
-            .zip(frame.triangle.par_chunks_mut(band))
-            .zip(tiles.par_chunks(tiles_x))
+        let targets = frame_tiles(&mut frame, bin::TILE as usize);
+        debug_assert_eq!(targets.len(), self.binned.tile_count());
+        targets
+            .into_par_iter()
             .enumerate()
-            .for_each(|(ty, ((((color, depth), coverage), triangle), row))| {
-                let y0 = ty as i32 * bin::TILE as i32;
-                let mut out = PixelsMut {
-                    color,
-                    depth,
-                    coverage,
-                    triangle,
-                    width: w,
-                    y0,
-                };
-                row.iter().for_each(|tile| out.put(tile));
-            });
+            .for_each(|(t, mut out)| self.resolve(ctx, &self.raster_tile(t), &mut out));
         frame
     }
 
@@ -265,44 +324,4 @@ impl Pass {
         }
         out
     }
-}
-
-/// Mutable frame channels for the rows starting at `y0`.
-struct PixelsMut<'a> {
-    color: &'a mut [Vec3],
-    depth: &'a mut [f32],
-    coverage: &'a mut [f32],
-    triangle: &'a mut [u32],
-    width: usize,
-    y0: i32,
-}
-
-impl PixelsMut<'_> {
-    /// Copy resolved pixels into their place.
-    fn put(&mut self, r: &Resolved) {
-        let [x0, y0, x1, y1] = r.rect;
-        let tw = (x1 - x0) as usize;
-        for (row, y) in (y0..y1).enumerate() {
-            let dst = (y - self.y0) as usize * self.width + x0 as usize;
-            let src = row * tw;
-            self.color[dst..dst + tw].copy_from_slice(&r.color[src..src + tw]);
-            self.depth[dst..dst + tw].copy_from_slice(&r.depth[src..src + tw]);
-            self.coverage[dst..dst + tw].copy_from_slice(&r.coverage[src..src + tw]);
-            self.triangle[dst..dst + tw].copy_from_slice(&r.triangle[src..src + tw]);
-        }
-    }
-}
-
-/// Copy resolved pixels into their place in a frame.
-pub(crate) fn blit(frame: &mut Frame, r: &Resolved) {
-    let width = frame.width as usize;
-    PixelsMut {
-        color: &mut frame.color,
-        depth: &mut frame.depth,
-        coverage: &mut frame.coverage,
-        triangle: &mut frame.triangle,
-        width,
-        y0: 0,
-    }
-    .put(r);
 }
