@@ -41,7 +41,7 @@ pub(crate) struct RectMut<'a> {
     col: usize,
 }
 
-/// One pixel row of a [`RectMut`].
+/// A run of pixels of a frame: the same slice of every channel.
 struct RowMut<'a> {
     color: &'a mut [Vec3],
     depth: &'a mut [f32],
@@ -49,7 +49,52 @@ struct RowMut<'a> {
     triangle: &'a mut [u32],
 }
 
-impl RectMut<'_> {
+impl<'a> RowMut<'a> {
+    /// All pixels of `frame`, row-major.
+    fn all(frame: &'a mut Frame) -> RowMut<'a> {
+        RowMut {
+            color: &mut frame.color,
+            depth: &mut frame.depth,
+            coverage: &mut frame.coverage,
+            triangle: &mut frame.triangle,
+        }
+    }
+
+    /// The run cut into consecutive runs of `n` pixels (the last may be shorter).
+    fn split(self, n: usize) -> impl Iterator<Item = RowMut<'a>> {
+        self.color
+            .chunks_mut(n)
+            .zip(self.depth.chunks_mut(n))
+            .zip(self.coverage.chunks_mut(n))
+            .zip(self.triangle.chunks_mut(n))
+            .map(|(((color, depth), coverage), triangle)| RowMut {
+                color,
+                depth,
+                coverage,
+                triangle,
+            })
+    }
+
+    /// Pixels `a..b` of the run.
+    fn range(self, a: usize, b: usize) -> RowMut<'a> {
+        RowMut {
+            color: &mut self.color[a..b],
+            depth: &mut self.depth[a..b],
+            coverage: &mut self.coverage[a..b],
+            triangle: &mut self.triangle[a..b],
+        }
+    }
+}
+
+impl<'a> RectMut<'a> {
+    fn new(rows: Vec<RowMut<'a>>) -> RectMut<'a> {
+        RectMut {
+            rows,
+            row: 0,
+            col: 0,
+        }
+    }
+
     /// Write the next pixel.
     #[inline]
     fn push(&mut self, color: Vec3, depth: f32, coverage: f32, triangle: u32) {
@@ -66,27 +111,13 @@ impl RectMut<'_> {
 /// The pixel rectangle `[x0, y0, x1, y1)` of `frame` as a resolve target.
 pub(crate) fn frame_rect(frame: &mut Frame, [x0, y0, x1, y1]: [i32; 4]) -> RectMut<'_> {
     let w = frame.width as usize;
-    let (a, b) = (x0 as usize, x1 as usize);
-    let rows = frame
-        .color
-        .chunks_mut(w)
-        .zip(frame.depth.chunks_mut(w))
-        .zip(frame.coverage.chunks_mut(w))
-        .zip(frame.triangle.chunks_mut(w))
+    let rows = RowMut::all(frame)
+        .split(w)
         .skip(y0 as usize)
         .take((y1 - y0) as usize)
-        .map(|(((color, depth), coverage), triangle)| RowMut {
-            color: &mut color[a..b],
-            depth: &mut depth[a..b],
-            coverage: &mut coverage[a..b],
-            triangle: &mut triangle[a..b],
-        })
+        .map(|row| row.range(x0 as usize, x1 as usize))
         .collect();
-    RectMut {
-        rows,
-        row: 0,
-        col: 0,
-    }
+    RectMut::new(rows)
 }
 
 /// `frame` cut into the resolve targets of its `tile`×`tile` tiles, row-major tile order.
@@ -95,31 +126,11 @@ fn frame_tiles(frame: &mut Frame, tile: usize) -> Vec<RectMut<'_>> {
     let tiles_x = w.div_ceil(tile);
     let n_tiles = tiles_x * (frame.height as usize).div_ceil(tile);
     let mut tiles: Vec<RectMut> = (0..n_tiles)
-        .map(|_| RectMut {
-            rows: Vec::with_capacity(tile),
-            row: 0,
-            col: 0,
-        })
+        .map(|_| RectMut::new(Vec::with_capacity(tile)))
         .collect();
-    let rows = frame
-        .color
-        .chunks_mut(w)
-        .zip(frame.depth.chunks_mut(w))
-        .zip(frame.coverage.chunks_mut(w))
-        .zip(frame.triangle.chunks_mut(w));
-    for (y, (((color, depth), coverage), triangle)) in rows.enumerate() {
-        let pieces = color
-            .chunks_mut(tile)
-            .zip(depth.chunks_mut(tile))
-            .zip(coverage.chunks_mut(tile))
-            .zip(triangle.chunks_mut(tile));
-        for (tx, (((color, depth), coverage), triangle)) in pieces.enumerate() {
-            tiles[y / tile * tiles_x + tx].rows.push(RowMut {
-                color,
-                depth,
-                coverage,
-                triangle,
-            });
+    for (y, row) in RowMut::all(frame).split(w).enumerate() {
+        for (tx, piece) in row.split(tile).enumerate() {
+            tiles[y / tile * tiles_x + tx].rows.push(piece);
         }
     }
     tiles

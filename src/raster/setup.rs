@@ -54,8 +54,7 @@ impl SetupTri {
     /// Twice the signed area in Fx24_8² units, > 0.
     #[inline]
     pub fn area(&self) -> i64 {
-        let [a, b, c] = self.v.map(|q| [q[0] as i64, q[1] as i64]);
-        (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0])
+        doubled_area(self.v)
     }
 
     /// Covered pixel rectangle `[x0, y0, x1, y1)`.
@@ -63,6 +62,14 @@ impl SetupTri {
     pub fn bbox(&self) -> [i32; 4] {
         self.bbox.map(i32::from)
     }
+}
+
+/// Twice the signed area of fixed-point triangle `v` under [`edge`](super::edge)'s edge function
+/// (negative for front faces before set-up reorders them).
+#[inline]
+fn doubled_area(v: [[i32; 2]; 3]) -> i64 {
+    let [a, b, c] = v.map(|q| [q[0] as i64, q[1] as i64]);
+    (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0])
 }
 
 /// The corners are the source triangle's vertices 0, 1, 2.
@@ -217,11 +224,7 @@ fn emit(
     let mut v = p.map(|q| q.v);
     let mut z = p.map(|q| q.z);
     let mut inv_w = p.map(|q| q.inv_w);
-    let e = |a: [i32; 2], b: [i32; 2], p: [i32; 2]| {
-        (b[0] as i64 - a[0] as i64) * (p[1] as i64 - a[1] as i64)
-            - (b[1] as i64 - a[1] as i64) * (p[0] as i64 - a[0] as i64)
-    };
-    let area = e(v[0], v[1], v[2]);
+    let area = doubled_area(v);
     if area == 0 {
         return;
     }
