@@ -261,6 +261,8 @@ fn render_cli_writes_pngs_and_rejects_bad_requests() {
     assert_eq!(std::fs::read_dir(&views).unwrap().count(), 5);
     for (args, expect) in [
         (vec!["--size", "0"], "image size 0x0"),
+        // Past the 16-bit pixel boxes of the set-up records (setup.rs).
+        (vec!["--size", "16385"], "image size 16385x16385"),
         (vec!["--rig", "cube"], "--rig cube"),
         (vec!["--shading", "toon"], "--shading toon"),
         (vec!["--samples", "3"], "--samples 3"),
