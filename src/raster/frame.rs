@@ -26,6 +26,16 @@ pub struct Frame {
     pub(crate) triangle: Vec<u32>,
 }
 
+impl Drop for Frame {
+    /// The channels go back to the renderer's pool (`recycle.rs`) for the next frame of this size.
+    fn drop(&mut self) {
+        super::recycle::give(std::mem::take(&mut self.color));
+        super::recycle::give(std::mem::take(&mut self.depth));
+        super::recycle::give(std::mem::take(&mut self.coverage));
+        super::recycle::give(std::mem::take(&mut self.triangle));
+    }
+}
+
 impl Frame {
     /// Width in pixels.
     pub fn width(&self) -> u32 {

@@ -23,6 +23,7 @@ mod fixed;
 mod frame;
 pub mod luminance;
 mod prepare;
+mod recycle;
 mod region;
 mod resolve;
 mod setup;

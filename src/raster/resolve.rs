@@ -11,6 +11,7 @@ use super::bin::{self, Binned};
 use super::clip::ClipPlanes;
 use super::edge::{self, EMPTY, TileSamples};
 use super::frame::{Frame, NO_TRIANGLE};
+use super::recycle;
 use super::setup::{self, Viewport, XfVertex};
 use super::shade::{ResolvedLight, ShadeContext};
 use super::{RenderSettings, Shading, camera_setup, vertex_lighting};
@@ -134,14 +135,6 @@ fn frame_tiles(frame: &mut Frame, tile: usize) -> Vec<RectMut<'_>> {
         }
     }
     tiles
-}
-
-/// A frame channel of `n` copies of `value`, written in parallel (a serial fill of the 12 MB
-/// colour channel of a 1024² frame was a visible share of a frame's time).
-fn filled<T: Copy + Send + Sync>(n: usize, value: T) -> Vec<T> {
-    let mut out = Vec::with_capacity(n);
-    out.par_extend(rayon::iter::repeat_n(value, n));
-    out
 }
 
 impl Pass {
@@ -291,20 +284,27 @@ impl Pass {
                 );
             }
         }
+        // Recycled channels rely on this: every pixel of the target has been written.
+        assert_eq!(
+            (out.row, out.col),
+            (out.rows.len(), 0),
+            "resolve left pixels unwritten"
+        );
     }
 
     /// Rasterize and resolve every tile, in parallel, each straight into its pixels of the frame.
     pub fn resolve_frame(&self, ctx: &ShadeContext) -> Frame {
         let (w, h) = (self.settings.width as usize, self.settings.height as usize);
         let n = w * h;
-        // Every pixel is written by exactly one tile; the fill values are never seen.
+        // Every pixel is written by exactly one tile, so the channels' previous contents (fill
+        // values, or an earlier frame's pixels when recycled) are never seen.
         let mut frame = Frame {
             width: w as u32,
             height: h as u32,
-            color: filled(n, Vec3::ZERO),
-            depth: filled(n, 0.0),
-            coverage: filled(n, 0.0),
-            triangle: filled(n, 0),
+            color: recycle::take(n, Vec3::ZERO),
+            depth: recycle::take(n, 0.0),
+            coverage: recycle::take(n, 0.0),
+            triangle: recycle::take(n, 0),
         };
         let targets = frame_tiles(&mut frame, bin::TILE as usize);
         debug_assert_eq!(targets.len(), self.binned.tile_count());
