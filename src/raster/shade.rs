@@ -101,32 +101,40 @@ impl ResolvedLight {
     }
 }
 
-/// Source-triangle barycentrics at screen point (x, y) in pixels of set-up triangle `st` whose
-/// corners have source barycentrics `corners`, and the screen-space barycentrics.
-pub(crate) fn source_barycentrics(
-    st: &SetupTri,
-    corners: &[Vec3; 3],
-    x: f64,
-    y: f64,
-) -> (Vec3, [f64; 3]) {
-    // Fixed-point corners in pixels; λ_i = E_i(x, y) / area (both in px²).
+/// The three edge functions of set-up triangle `st` at screen point (x, y) in pixels, in px²:
+/// E_i / (2·area) is the screen-space barycentric weight of corner i.
+fn edge_values(st: &SetupTri, x: f64, y: f64) -> [f64; 3] {
     let p =
         st.v.map(|q| [q[0] as f64 * (1.0 / 256.0), q[1] as f64 * (1.0 / 256.0)]);
+    let edge = |a: [f64; 2], b: [f64; 2]| (b[0] - a[0]) * (y - a[1]) - (b[1] - a[1]) * (x - a[0]);
+    [edge(p[1], p[2]), edge(p[2], p[0]), edge(p[0], p[1])]
+}
+
+/// Screen-space barycentrics λ of set-up triangle `st` at screen point (x, y) in pixels.
+fn screen_barycentrics(st: &SetupTri, x: f64, y: f64) -> [f64; 3] {
+    // `area()` is in Fx24_8² units: 65536 per px².
     let inv_area = 65536.0 / st.area() as f64;
-    let edge = |a: [f64; 2], b: [f64; 2]| {
-        ((b[0] - a[0]) * (y - a[1]) - (b[1] - a[1]) * (x - a[0])) * inv_area
-    };
-    let lambda = [edge(p[1], p[2]), edge(p[2], p[0]), edge(p[0], p[1])];
-    // Perspective correction: weight by 1/w and renormalise.
-    let mu = [0, 1, 2].map(|i| lambda[i] * st.inv_w[i] as f64);
+    edge_values(st, x, y).map(|e| e * inv_area)
+}
+
+/// Source-triangle barycentrics at screen point (x, y) in pixels of set-up triangle `st` whose
+/// corners have source barycentrics `corners`.
+///
+/// Perspective correction weights the screen-space barycentrics by 1/w and renormalises; the
+/// common 1/area factor cancels in the renormalisation, so the edge values are used unscaled, and
+/// the renormalisation is one reciprocal (this runs for every shaded pixel, and the four
+/// divisions it had were a third of its time). Both are f64 rounded once to f32 at the end.
+pub(crate) fn source_barycentrics(st: &SetupTri, corners: &[Vec3; 3], x: f64, y: f64) -> Vec3 {
+    let e = edge_values(st, x, y);
+    let mu = [0, 1, 2].map(|i| e[i] * st.inv_w[i] as f64);
     let sum = mu[0] + mu[1] + mu[2];
     let mu = if sum != 0.0 {
-        mu.map(|m| (m / sum) as f32)
+        let r = 1.0 / sum;
+        mu.map(|m| (m * r) as f32)
     } else {
         [1.0 / 3.0; 3]
     };
-    let b = corners[0] * mu[0] + corners[1] * mu[1] + corners[2] * mu[2];
-    (b, lambda)
+    corners[0] * mu[0] + corners[1] * mu[1] + corners[2] * mu[2]
 }
 
 impl ShadeContext<'_> {
@@ -135,7 +143,7 @@ impl ShadeContext<'_> {
         let st = self.setup.get(id);
         let corners = self.setup.corner_barycentrics(id);
         let tri = self.mesh.triangles()[st.tri as usize].map(|i| i as usize);
-        let (b, lambda) = source_barycentrics(st, &corners, x, y);
+        let b = source_barycentrics(st, &corners, x, y);
         let lerp3 = |a: &[Vec3]| a[tri[0]] * b.x + a[tri[1]] * b.y + a[tri[2]] * b.z;
         let material_id = self.mesh.material_ids()[st.tri as usize] as usize;
         let material = &self.mesh.materials()[material_id];
@@ -145,6 +153,7 @@ impl ShadeContext<'_> {
             Shading::Normals => return lerp3(self.mesh.normals()).normalize_or_zero() * 0.5 + 0.5,
             Shading::Depth => {
                 let (near, far, perspective) = self.depth_range;
+                let lambda = screen_barycentrics(st, x, y);
                 let t = if perspective {
                     let inv_w: f64 = (0..3).map(|i| lambda[i] * st.inv_w[i] as f64).sum();
                     ((1.0 / inv_w) as f32 - near) / (far - near)
@@ -161,8 +170,8 @@ impl ShadeContext<'_> {
             |bb: Vec3, uvs: &[Vec2]| uvs[tri[0]] * bb.x + uvs[tri[1]] * bb.y + uvs[tri[2]] * bb.z;
         let uv_frame = self.mesh.uvs().map(|uvs| {
             let uv = uv_at(b, uvs);
-            let dx = uv_at(source_barycentrics(st, &corners, x + 1.0, y).0, uvs) - uv;
-            let dy = uv_at(source_barycentrics(st, &corners, x, y + 1.0).0, uvs) - uv;
+            let dx = uv_at(source_barycentrics(st, &corners, x + 1.0, y), uvs) - uv;
+            let dy = uv_at(source_barycentrics(st, &corners, x, y + 1.0), uvs) - uv;
             (uv, dx, dy)
         });
         let mut albedo = material.base_color;
