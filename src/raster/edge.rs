@@ -99,6 +99,18 @@ pub(crate) fn rasterize(
         bias[i] = if top_left { 0 } else { -1 };
     }
     let s = offsets.len();
+    let rect = [x0, y0, x1, y1];
+    if s == 1 && buf.counts.is_none() {
+        // One sample per pixel (a dense mesh's triangles cover a pixel or two): the sample offset
+        // and bias go straight into the start values, with no per-sample table.
+        let o = offsets[0];
+        let mut start = origin;
+        for i in 0..3 {
+            start[i] += coef[i][0] * o[0] + coef[i][1] * o[1] + bias[i];
+        }
+        scan_one_sample(st, id, rect, &Edges { origin: start, coef, bias }, buf);
+        return;
+    }
     // Per-sample offsets of each edge value from the pixel corner, bias folded in, written into the
     // caller's scratch (a zero-initialised array per triangle cost more than the rasterization).
     let sample_off = &mut scratch[..s];
@@ -107,13 +119,11 @@ pub(crate) fn rasterize(
             so[i] = coef[i][0] * o[0] + coef[i][1] * o[1] + bias[i];
         }
     }
-    // The common sample counts get a loop the compiler can unroll (1 and 4 samples).
+    // Four samples get a loop the compiler can unroll.
     let edges = Edges { origin, coef, bias };
-    let rect = [x0, y0, x1, y1];
     // Coverage counting (a diagnostic) gets its own instance, so the render path has no
     // per-sample branch for it.
     match (s, buf.counts.is_some()) {
-        (1, false) => scan::<1, false>(st, id, rect, &edges, sample_off, buf),
         (4, false) => scan::<4, false>(st, id, rect, &edges, sample_off, buf),
         (_, false) => scan::<0, false>(st, id, rect, &edges, sample_off, buf),
         (_, true) => scan::<0, true>(st, id, rect, &edges, sample_off, buf),
@@ -126,6 +136,52 @@ struct Edges {
     origin: [i64; 3],
     coef: [[i64; 2]; 3],
     bias: [i64; 3],
+}
+
+/// The pixel loop of [`rasterize`] at one sample per pixel, without coverage counting: `edges`
+/// origin holds the biased edge values at the first pixel's sample. The same tests and depths as
+/// [`scan`] with `S = 1`.
+fn scan_one_sample(
+    st: &SetupTri,
+    id: u32,
+    [x0, y0, x1, y1]: [i32; 4],
+    edges: &Edges,
+    buf: &mut TileSamples,
+) {
+    let Edges { origin, coef, bias } = *edges;
+    let one = super::fixed::ONE_PIXEL;
+    let step_x = coef.map(|c| c[0] * one);
+    let step_y = coef.map(|c| c[1] * one);
+    // 1/area on the first covered sample: a third of a dense mesh's triangles cover none.
+    let mut inv_area = 0.0f64;
+    let tile_w = (buf.rect[2] - buf.rect[0]) as usize;
+    let mut row = origin;
+    for y in y0..y1 {
+        let mut e = row;
+        let base_y = (y - buf.rect[1]) as usize * tile_w;
+        for x in x0..x1 {
+            if (e[0] | e[1] | e[2]) >= 0 {
+                if inv_area == 0.0 {
+                    inv_area = 1.0 / st.area() as f64;
+                }
+                let slot = base_y + (x - buf.rect[0]) as usize;
+                let w = [0, 1, 2].map(|i| (e[i] - bias[i]) as f64);
+                let z = st.z.map(|v| v as f64);
+                let depth = ((w[0] * z[0] + w[1] * z[1] + w[2] * z[2]) * inv_area) as f32;
+                let d = buf.depth[slot];
+                if depth < d || (buf.lowest_id_wins_ties && depth == d && id < buf.ids[slot]) {
+                    buf.depth[slot] = depth;
+                    buf.ids[slot] = id;
+                }
+            }
+            for i in 0..3 {
+                e[i] += step_x[i];
+            }
+        }
+        for i in 0..3 {
+            row[i] += step_y[i];
+        }
+    }
 }
 
 /// The pixel loop of [`rasterize`]; `S` is the sample count, or 0 for "read it from the slice";
