@@ -18,7 +18,7 @@ use glam::Vec3;
 use rayon::prelude::*;
 
 use super::clip::ClipPlanes;
-use super::setup::{SetupOut, SetupTri, Viewport, XfVertex, corner_barycentrics, setup_one};
+use super::setup::{Corners, SetupOut, SetupTri, Viewport, XfVertex, setup_one};
 
 /// Tile edge in pixels.
 pub const TILE: u32 = 64;
@@ -62,14 +62,14 @@ impl Binned {
         &self.chunks[(id >> 16) as usize].tris[(id & 0xFFFF) as usize]
     }
 
-    /// Barycentrics of the corners of set-up triangle `id` with respect to its source triangle.
-    pub fn corner_barycentrics(&self, id: u32) -> [Vec3; 3] {
+    /// Where the corners of set-up triangle `id` lie on its source triangle.
+    pub fn corners(&self, id: u32) -> Corners {
         let clipped = if id & OVERLAY != 0 {
             &self.overlay.clipped
         } else {
             &self.chunks[(id >> 16) as usize].clipped
         };
-        corner_barycentrics(self.get(id).corners, clipped)
+        Corners::decode(self.get(id).corners, clipped)
     }
 
     fn is_stale(&self, src: u32) -> bool {

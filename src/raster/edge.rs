@@ -108,7 +108,17 @@ pub(crate) fn rasterize(
         for i in 0..3 {
             start[i] += coef[i][0] * o[0] + coef[i][1] * o[1] + bias[i];
         }
-        scan_one_sample(st, id, rect, &Edges { origin: start, coef, bias }, buf);
+        scan_one_sample(
+            st,
+            id,
+            rect,
+            &Edges {
+                origin: start,
+                coef,
+                bias,
+            },
+            buf,
+        );
         return;
     }
     // Per-sample offsets of each edge value from the pixel corner, bias folded in, written into the

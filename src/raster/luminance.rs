@@ -54,7 +54,7 @@ pub const LUMA_MAX: u16 = u16::MAX;
 #[derive(Debug, Clone, Copy)]
 struct Piece {
     st: SetupTri,
-    bary: [Vec3; 3],
+    bary: super::setup::Corners,
 }
 
 /// What shading needs of a material.
@@ -489,7 +489,7 @@ impl View {
                     &mut tr.setup,
                 );
                 for st in &tr.setup.tris {
-                    let bary = super::setup::corner_barycentrics(st.corners, &tr.setup.clipped);
+                    let bary = super::setup::Corners::decode(st.corners, &tr.setup.clipped);
                     tr.pieces.push((t, Piece { st: *st, bary }));
                     bb = Some(union(bb, st.bbox()));
                 }

@@ -79,12 +79,38 @@ pub(crate) const CORNERS_SWAPPED: u32 = 1;
 /// First code of a clipped corner set.
 pub(crate) const CORNERS_CLIPPED: u32 = 2;
 
-/// Decode [`SetupTri::corners`] given the owner's clipped-corner table.
-pub(crate) fn corner_barycentrics(code: u32, clipped: &[[Vec3; 3]]) -> [Vec3; 3] {
-    match code {
-        CORNERS_SOURCE => [Vec3::X, Vec3::Y, Vec3::Z],
-        CORNERS_SWAPPED => [Vec3::X, Vec3::Z, Vec3::Y],
-        k => clipped[(k - CORNERS_CLIPPED) as usize],
+/// Where a set-up triangle's corners lie on its source triangle, decoded from
+/// [`SetupTri::corners`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) enum Corners {
+    /// Corners 0, 1, 2 are the source vertices 0, 1, 2.
+    Source,
+    /// Corners 0, 1, 2 are the source vertices 0, 2, 1.
+    Swapped,
+    /// Clipped corners, as barycentrics of the source triangle.
+    Clipped([Vec3; 3]),
+}
+
+impl Corners {
+    /// Decode `code` given the owner's clipped-corner table.
+    pub fn decode(code: u32, clipped: &[[Vec3; 3]]) -> Corners {
+        match code {
+            CORNERS_SOURCE => Corners::Source,
+            CORNERS_SWAPPED => Corners::Swapped,
+            k => Corners::Clipped(clipped[(k - CORNERS_CLIPPED) as usize]),
+        }
+    }
+
+    /// Source-triangle barycentrics of the point with corner weights `mu`. For the unclipped
+    /// codes this is a permutation, not the weighted sum of unit vectors it equals (the same
+    /// values; a sum could differ only in the sign of a zero).
+    #[inline]
+    pub fn apply(&self, mu: [f32; 3]) -> Vec3 {
+        match self {
+            Corners::Source => Vec3::new(mu[0], mu[1], mu[2]),
+            Corners::Swapped => Vec3::new(mu[0], mu[2], mu[1]),
+            Corners::Clipped(c) => c[0] * mu[0] + c[1] * mu[1] + c[2] * mu[2],
+        }
     }
 }
 

@@ -21,7 +21,7 @@
 use glam::{Vec2, Vec3};
 
 use super::bin::Binned;
-use super::setup::SetupTri;
+use super::setup::{Corners, SetupTri};
 use super::{PreparedMesh, Shading};
 use crate::mesh::Mesh;
 
@@ -124,7 +124,7 @@ fn screen_barycentrics(st: &SetupTri, x: f64, y: f64) -> [f64; 3] {
 /// common 1/area factor cancels in the renormalisation, so the edge values are used unscaled, and
 /// the renormalisation is one reciprocal (this runs for every shaded pixel, and the four
 /// divisions it had were a third of its time). Both are f64 rounded once to f32 at the end.
-pub(crate) fn source_barycentrics(st: &SetupTri, corners: &[Vec3; 3], x: f64, y: f64) -> Vec3 {
+pub(crate) fn source_barycentrics(st: &SetupTri, corners: &Corners, x: f64, y: f64) -> Vec3 {
     let e = edge_values(st, x, y);
     let mu = [0, 1, 2].map(|i| e[i] * st.inv_w[i] as f64);
     let sum = mu[0] + mu[1] + mu[2];
@@ -134,14 +134,14 @@ pub(crate) fn source_barycentrics(st: &SetupTri, corners: &[Vec3; 3], x: f64, y:
     } else {
         [1.0 / 3.0; 3]
     };
-    corners[0] * mu[0] + corners[1] * mu[1] + corners[2] * mu[2]
+    corners.apply(mu)
 }
 
 impl ShadeContext<'_> {
     /// Shade set-up triangle `id` at screen point (x, y) (pixels).
     pub fn shade(&self, id: u32, x: f64, y: f64) -> Vec3 {
         let st = self.setup.get(id);
-        let corners = self.setup.corner_barycentrics(id);
+        let corners = self.setup.corners(id);
         let tri = self.mesh.triangles()[st.tri as usize].map(|i| i as usize);
         let b = source_barycentrics(st, &corners, x, y);
         let lerp3 = |a: &[Vec3]| a[tri[0]] * b.x + a[tri[1]] * b.y + a[tri[2]] * b.z;
