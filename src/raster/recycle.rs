@@ -9,16 +9,16 @@
 //!
 //! A recycled buffer keeps its old values: only callers that overwrite every entry may take one
 //! (`resolve_frame` does: every pixel belongs to exactly one tile, which writes it). Outputs
-//! therefore never depend on what the pool holds. The pool is bounded ([`KEEP`] buffers per
-//! element type, each at least [`MIN_LEN`] entries), so it retains at most a few frames' worth of
-//! memory.
+//! therefore never depend on what the pool holds. The pool is bounded ([`KEEP_FRAMES`] frames'
+//! worth of buffers, each at least [`MIN_LEN`] entries).
 
 use std::sync::Mutex;
 
 use glam::Vec3;
 
-/// Buffers kept per element type (two frames — an original and its LOD — in flight, twice).
-const KEEP: usize = 8;
+/// Frames' worth of buffers kept (two frames — an original and its LOD — in flight, twice): at
+/// most 4 × 24 MB at 1024².
+const KEEP_FRAMES: usize = 4;
 /// Smaller buffers are not kept: they are not where the page faults are.
 const MIN_LEN: usize = 1 << 16;
 
@@ -33,23 +33,28 @@ static POOL: Mutex<Pool> = Mutex::new(Pool::new());
 
 /// Element types the pool keeps.
 pub(crate) trait Recyclable: Copy + Send + Sync + 'static {
+    /// Channels of this type in a frame.
+    const PER_FRAME: usize;
     /// This type's list in the pool.
     fn list(pool: &mut Pool) -> &mut Vec<Vec<Self>>;
 }
 
 impl Recyclable for Vec3 {
+    const PER_FRAME: usize = 1; // colour
     fn list(pool: &mut Pool) -> &mut Vec<Vec<Self>> {
         &mut pool.color
     }
 }
 
 impl Recyclable for f32 {
+    const PER_FRAME: usize = 2; // depth, coverage
     fn list(pool: &mut Pool) -> &mut Vec<Vec<Self>> {
         &mut pool.scalar
     }
 }
 
 impl Recyclable for u32 {
+    const PER_FRAME: usize = 1; // triangle id
     fn list(pool: &mut Pool) -> &mut Vec<Vec<Self>> {
         &mut pool.id
     }
@@ -78,7 +83,7 @@ impl Pool {
             return;
         }
         let list = T::list(self);
-        if list.len() == KEEP {
+        if list.len() == KEEP_FRAMES * T::PER_FRAME {
             list.remove(0);
         }
         list.push(buffer);
@@ -146,13 +151,14 @@ mod tests {
         let mut pool = Pool::new();
         pool.give(vec![0.0f32; 16]);
         assert!(pool.take::<f32>(16).is_none());
-        for k in 0..KEEP + 3 {
+        let keep = KEEP_FRAMES * f32::PER_FRAME;
+        for k in 0..keep + 3 {
             pool.give(vec![0.0f32; MIN_LEN + k]);
         }
-        assert_eq!(pool.scalar.len(), KEEP);
+        assert_eq!(pool.scalar.len(), keep);
         // The oldest went first.
         assert!(pool.take::<f32>(MIN_LEN).is_none());
-        assert!(pool.take::<f32>(MIN_LEN + KEEP + 2).is_some());
+        assert!(pool.take::<f32>(MIN_LEN + keep + 2).is_some());
     }
 
     #[test]
