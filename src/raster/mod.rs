@@ -10,6 +10,9 @@
 //!    triangle among its samples, at that triangle's first covered sample, and average the samples in
 //!    linear light.
 //!
+//! Frames' channel buffers are reused from one render to the next (`recycle.rs`); every pixel is
+//! written by exactly one tile, so a reused buffer's old contents never show.
+//!
 //! Rules: every tile owns its pixels and processes triangles in index order with a strict
 //! depth test (ties keep the earlier triangle), and no reduction depends on completion order, so
 //! frames are byte-identical for any thread count. Shading once per pixel per triangle (rather
