@@ -151,39 +151,41 @@ struct Edges {
 /// The pixel loop of [`rasterize`] at one sample per pixel, without coverage counting: `edges`
 /// origin holds the biased edge values at the first pixel's sample. The same tests and depths as
 /// [`scan`] with `S = 1`.
-fn scan_one_sample(
-    st: &SetupTri,
-    id: u32,
-    [x0, y0, x1, y1]: [i32; 4],
-    edges: &Edges,
-    buf: &mut TileSamples,
-) {
-    let Edges { origin, coef, bias } = *edges;
-    let one = super::fixed::ONE_PIXEL;
-    let step_x = coef.map(|c| c[0] * one);
-    let step_y = coef.map(|c| c[1] * one);
+fn scan_one_sample(st: &SetupTri, id: u32, rect: [i32; 4], edges: &Edges, buf: &mut TileSamples) {
+    let bias = edges.bias;
     // 1/area on the first covered sample: a third of a dense mesh's triangles cover none.
     let mut inv_area = 0.0f64;
-    let tile_w = (buf.rect[2] - buf.rect[0]) as usize;
-    let mut row = origin;
+    for_each_pixel(rect, buf.rect, edges, |pixel, e| {
+        if (e[0] | e[1] | e[2]) >= 0 {
+            if inv_area == 0.0 {
+                inv_area = 1.0 / st.area() as f64;
+            }
+            let w = [0, 1, 2].map(|i| (e[i] - bias[i]) as f64);
+            depth_test(buf, pixel, id, interpolated_depth(st, w, inv_area));
+        }
+    });
+}
+
+/// Call `f(pixel, e)` for the pixels of `rect` in row-major order, with the pixel's index in the
+/// tile `tile` and the edge functions at it (stepped from `edges.origin`, the values at `rect`'s
+/// first pixel).
+#[inline(always)]
+fn for_each_pixel(
+    [x0, y0, x1, y1]: [i32; 4],
+    tile: [i32; 4],
+    edges: &Edges,
+    mut f: impl FnMut(usize, [i64; 3]),
+) {
+    let one = super::fixed::ONE_PIXEL;
+    let step_x = edges.coef.map(|c| c[0] * one);
+    let step_y = edges.coef.map(|c| c[1] * one);
+    let tile_w = (tile[2] - tile[0]) as usize;
+    let mut row = edges.origin;
     for y in y0..y1 {
         let mut e = row;
-        let base_y = (y - buf.rect[1]) as usize * tile_w;
+        let base_y = (y - tile[1]) as usize * tile_w;
         for x in x0..x1 {
-            if (e[0] | e[1] | e[2]) >= 0 {
-                if inv_area == 0.0 {
-                    inv_area = 1.0 / st.area() as f64;
-                }
-                let slot = base_y + (x - buf.rect[0]) as usize;
-                let w = [0, 1, 2].map(|i| (e[i] - bias[i]) as f64);
-                let z = st.z.map(|v| v as f64);
-                let depth = ((w[0] * z[0] + w[1] * z[1] + w[2] * z[2]) * inv_area) as f32;
-                let d = buf.depth[slot];
-                if depth < d || (buf.lowest_id_wins_ties && depth == d && id < buf.ids[slot]) {
-                    buf.depth[slot] = depth;
-                    buf.ids[slot] = id;
-                }
-            }
+            f(base_y + (x - tile[0]) as usize, e);
             for i in 0..3 {
                 e[i] += step_x[i];
             }
@@ -194,58 +196,54 @@ fn scan_one_sample(
     }
 }
 
+/// NDC depth at a sample with unbiased edge values `w` (twice the sub-areas, so `w / area` are
+/// the barycentric weights).
+#[inline(always)]
+fn interpolated_depth(st: &SetupTri, w: [f64; 3], inv_area: f64) -> f32 {
+    let z = st.z.map(|v| v as f64);
+    ((w[0] * z[0] + w[1] * z[1] + w[2] * z[2]) * inv_area) as f32
+}
+
+/// Keep `depth` and `id` at sample `slot` if nearer (or, where `lowest_id_wins_ties`, as near and
+/// with a lower id).
+#[inline(always)]
+fn depth_test(buf: &mut TileSamples, slot: usize, id: u32, depth: f32) {
+    let d = buf.depth[slot];
+    if depth < d || (buf.lowest_id_wins_ties && depth == d && id < buf.ids[slot]) {
+        buf.depth[slot] = depth;
+        buf.ids[slot] = id;
+    }
+}
+
 /// The pixel loop of [`rasterize`]; `S` is the sample count, or 0 for "read it from the slice";
 /// `COUNT` says whether `buf.counts` is there to count coverage.
 #[inline(always)]
 fn scan<const S: usize, const COUNT: bool>(
     st: &SetupTri,
     id: u32,
-    [x0, y0, x1, y1]: [i32; 4],
+    rect: [i32; 4],
     edges: &Edges,
     sample_off: &[[i64; 3]],
     buf: &mut TileSamples,
 ) {
-    let Edges { origin, coef, bias } = *edges;
-    let one = super::fixed::ONE_PIXEL;
+    let bias = edges.bias;
     let s = if S == 0 { sample_off.len() } else { S };
     let sample_off = &sample_off[..s];
     let inv_area = 1.0 / st.area() as f64;
-    let z = st.z.map(|v| v as f64);
-    let tile_w = (buf.rect[2] - buf.rect[0]) as usize;
-    let mut row = origin;
-    for y in y0..y1 {
-        let mut e = row;
-        let base_y = (y - buf.rect[1]) as usize * tile_w;
-        for x in x0..x1 {
-            let base = (base_y + (x - buf.rect[0]) as usize) * s;
-            for (k, so) in sample_off.iter().enumerate() {
-                let (e0, e1, e2) = (e[0] + so[0], e[1] + so[1], e[2] + so[2]);
-                if (e0 | e1 | e2) < 0 {
-                    continue;
-                }
-                let slot = base + k;
-                if COUNT && let Some(c) = buf.counts.as_mut() {
-                    c[slot] = c[slot].saturating_add(1);
-                }
-                // Unbiased values give the barycentric weights.
-                let (w0, w1, w2) = (
-                    (e0 - bias[0]) as f64,
-                    (e1 - bias[1]) as f64,
-                    (e2 - bias[2]) as f64,
-                );
-                let depth = ((w0 * z[0] + w1 * z[1] + w2 * z[2]) * inv_area) as f32;
-                let d = buf.depth[slot];
-                if depth < d || (buf.lowest_id_wins_ties && depth == d && id < buf.ids[slot]) {
-                    buf.depth[slot] = depth;
-                    buf.ids[slot] = id;
-                }
+    for_each_pixel(rect, buf.rect, edges, |pixel, e| {
+        let base = pixel * s;
+        for (k, so) in sample_off.iter().enumerate() {
+            let (e0, e1, e2) = (e[0] + so[0], e[1] + so[1], e[2] + so[2]);
+            if (e0 | e1 | e2) < 0 {
+                continue;
             }
-            e[0] += coef[0][0] * one;
-            e[1] += coef[1][0] * one;
-            e[2] += coef[2][0] * one;
+            let slot = base + k;
+            if COUNT && let Some(c) = buf.counts.as_mut() {
+                c[slot] = c[slot].saturating_add(1);
+            }
+            // Unbiased values give the barycentric weights.
+            let w = [e0 - bias[0], e1 - bias[1], e2 - bias[2]].map(|v| v as f64);
+            depth_test(buf, slot, id, interpolated_depth(st, w, inv_area));
         }
-        row[0] += coef[0][1] * one;
-        row[1] += coef[1][1] * one;
-        row[2] += coef[2][1] * one;
-    }
+    });
 }
