@@ -50,7 +50,7 @@ const RESHADE: u32 = 1 << 31;
 /// Largest luminance code.
 pub const LUMA_MAX: u16 = u16::MAX;
 
-/// One set-up piece of a source triangle (several when clipped) with its corner barycentrics.
+/// One set-up piece of a source triangle (several when clipped) with where its corners lie on it.
 #[derive(Debug, Clone, Copy)]
 struct Piece {
     st: SetupTri,

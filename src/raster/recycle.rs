@@ -3,7 +3,7 @@
 //!
 //! Why: a 1024² frame is 24 MB of channels. Allocated afresh per render, that memory comes from
 //! the kernel as new pages (glibc returns big freed blocks to it), and faulting them in cost more
-//! than a third of a 10 000-triangle frame's time (43 → 27 ms in alternating runs; see
+//! than a third of a 10 000-triangle frame's time (42.7 → 26.2 ms in alternating runs; see
 //! results/BENCHMARKS.md). Rendering many views in a loop — what `eval` and `bench` do — frees one
 //! frame and allocates the next of the same size, so a few kept buffers remove the faults.
 //!

@@ -101,8 +101,9 @@ impl ResolvedLight {
     }
 }
 
-/// The three edge functions of set-up triangle `st` at screen point (x, y) in pixels, in px²:
-/// E_i / (2·area) is the screen-space barycentric weight of corner i.
+/// The three edge functions of set-up triangle `st` at screen point (x, y) in pixels, in px²
+/// (twice the sub-triangle areas): divided by twice the triangle's area ([`SetupTri::area`]),
+/// they are the screen-space barycentric weights of the corners.
 fn edge_values(st: &SetupTri, x: f64, y: f64) -> [f64; 3] {
     let p =
         st.v.map(|q| [q[0] as f64 * (1.0 / 256.0), q[1] as f64 * (1.0 / 256.0)]);
