@@ -54,7 +54,7 @@ pub const LUMA_MAX: u16 = u16::MAX;
 #[derive(Debug, Clone, Copy)]
 struct Piece {
     st: SetupTri,
-    bary: super::setup::Corners,
+    corners: super::setup::Corners,
 }
 
 /// What shading needs of a material.
@@ -489,8 +489,8 @@ impl View {
                     &mut tr.setup,
                 );
                 for st in &tr.setup.tris {
-                    let bary = super::setup::Corners::decode(st.corners, &tr.setup.clipped);
-                    tr.pieces.push((t, Piece { st: *st, bary }));
+                    let corners = super::setup::Corners::decode(st.corners, &tr.setup.clipped);
+                    tr.pieces.push((t, Piece { st: *st, corners }));
                     bb = Some(union(bb, st.bbox()));
                 }
             }
@@ -696,7 +696,7 @@ fn shade(
     x: f64,
     y: f64,
 ) -> u16 {
-    let b = source_barycentrics(&p.st, &p.bary, x, y);
+    let b = source_barycentrics(&p.st, &p.corners, x, y);
     let c = mesh.corners(t).map(|w| w as usize);
     let wd = c.map(|w| &mesh.wedges[w]);
     let m = &shared.materials[mesh.material(t) as usize];
@@ -707,8 +707,8 @@ fn shade(
     if let (Some(tex), true) = (&m.texture, mesh.has_uvs()) {
         let uv_at = |bb: Vec3| -> Vec2 { wd[0].uv * bb.x + wd[1].uv * bb.y + wd[2].uv * bb.z };
         let uv = uv_at(b);
-        let dx = uv_at(source_barycentrics(&p.st, &p.bary, x + 1.0, y)) - uv;
-        let dy = uv_at(source_barycentrics(&p.st, &p.bary, x, y + 1.0)) - uv;
+        let dx = uv_at(source_barycentrics(&p.st, &p.corners, x + 1.0, y)) - uv;
+        let dy = uv_at(source_barycentrics(&p.st, &p.corners, x, y + 1.0)) - uv;
         albedo *= tex.sample(uv, dx, dy);
     }
     let d = light[c[0]].0 * b.x + light[c[1]].0 * b.y + light[c[2]].0 * b.z;

@@ -105,9 +105,7 @@ pub(crate) fn take<T: Recyclable>(n: usize, fill: T) -> Vec<T> {
 
 /// Give `buffer` back for a later [`take`].
 pub(crate) fn give<T: Recyclable>(buffer: Vec<T>) {
-    if buffer.len() >= MIN_LEN {
-        with_pool(|p| p.give(buffer));
-    }
+    with_pool(|p| p.give(buffer));
 }
 
 /// `n` copies of `value`, written in parallel (a serial fill of the 12 MB colour channel of a
