@@ -45,11 +45,9 @@ fn box_pass(src: &[f32], dst: &mut [f32], w: usize, h: usize, r: usize, along_ro
 pub fn blurred_difference(views: &LumaViews, h: usize) -> Vec<f32> {
     let (w, hh) = views.size();
     let (w, hh) = (w as usize, hh as usize);
-    let (cur, target) = views.view_images(h);
-    let mut a: Vec<f32> = cur
-        .iter()
-        .zip(target)
-        .map(|(&y, &t)| (y as f32 - t as f32).abs())
+    let mut a: Vec<f32> = views
+        .view_pixels(h)
+        .map(|(y, t)| (y as f32 - t as f32).abs())
         .collect();
     let mut b = vec![0.0f32; a.len()];
     for _ in 0..2 {
