@@ -165,11 +165,38 @@ struct View {
     light: Vec<(Vec3, Vec3)>,
     pieces: Vec<Vec<Piece>>,
     bbox: Vec<Option<[i32; 4]>>,
-    buckets: Vec<Vec<u32>>,
+    buckets: Vec<Vec<BucketEntry>>,
     tiles_x: u32,
     /// The committed image, row-major.
     px: Vec<Pixel>,
+    /// Unique in the process: names the scratch contents with the trial serial.
+    id: u64,
     trial: Trial,
+}
+
+/// A triangle in a bucket, with its box (so the triangles that miss a rectangle are passed over
+/// without touching their pieces).
+#[derive(Debug, Clone, Copy)]
+struct BucketEntry {
+    tri: u32,
+    bbox: [u16; 4],
+}
+
+impl BucketEntry {
+    fn new(tri: u32, b: [i32; 4]) -> BucketEntry {
+        // Boxes lie within the image, which is at most 4096 pixels per side.
+        BucketEntry {
+            tri,
+            bbox: b.map(|v| v as u16),
+        }
+    }
+
+    /// Whether its box overlaps rectangle `r`.
+    #[inline]
+    fn overlaps(&self, r: [i32; 4]) -> bool {
+        let b = self.bbox.map(i32::from);
+        b[0] < r[2] && r[0] < b[2] && b[1] < r[3] && r[1] < b[3]
+    }
 }
 
 /// A pixel of a view's committed image: what a trial reads and writes of it side by side (one
@@ -187,35 +214,76 @@ struct Pixel {
     target: u16,
 }
 
-/// A view's pending trial and its scratch buffers.
+/// A view's pending trial: what it changed and what a revert restores.
 #[derive(Debug, Default)]
 struct Trial {
+    /// Counts this view's trials (with the view's id, it names the scratch contents).
+    serial: u32,
     saved_xf: Vec<(u32, XfVertex)>,
     saved_light: Vec<(u32, (Vec3, Vec3))>,
-    /// New pieces: those of the changed triangles, then those of the re-shaded ones (the same
-    /// geometry with new luminance planes).
+    /// New pieces: those of the changed triangles (grouped by triangle, in `bbox`'s order), then
+    /// copies of re-shaded triangles' pieces made while shading.
     pieces: Vec<(u32, Piece)>,
     /// How many of `pieces` are the changed triangles' (the ones to rasterize).
     changed_pieces: usize,
+    /// Changed triangles and their new boxes.
+    bbox: Vec<(u32, Option<[i32; 4]>)>,
     /// Re-shaded triangles (their committed pieces' shading is forgotten on commit).
     reshaded: Vec<u32>,
-    /// Per source triangle: the trial number that copied its pieces for re-shading.
-    reshade_at: Vec<u32>,
-    bbox: Vec<(u32, Option<[i32; 4]>)>,
+    /// The dirty rectangle (`None`: nothing to render).
     rect: Option<[i32; 4]>,
-    pixels: Vec<u16>,
-    shown: Vec<u32>,
-    /// Per source triangle: the trial number that changed it (with [`RESHADE`] set when only its
-    /// shading changed).
-    stamp: Vec<u32>,
-    /// Per changed source triangle: index of its first new piece in `pieces`.
-    first_piece: Vec<u32>,
-    /// Per source triangle: the trial number that already rasterized it.
-    visited: Vec<u32>,
-    number: u32,
-    samples: Option<TileSamples>,
     setup: SetupOut,
 }
+
+/// Per-thread working memory of a trial's render: the rectangle's samples and luminance and the
+/// per-triangle stamps. Shared by every view a thread renders, so it stays in cache (per-view
+/// buffers were cold at every trial, each view's turn coming after nineteen others).
+#[derive(Debug)]
+struct Scratch {
+    samples: TileSamples,
+    pixels: Vec<u16>,
+    shown: Vec<u32>,
+    /// Per source triangle: the number of the render that changed it (with [`RESHADE`] set when
+    /// only its shading changed).
+    stamp: Vec<u32>,
+    /// Per changed source triangle: index of its first new piece in the trial's `pieces`.
+    first_piece: Vec<u32>,
+    /// Per source triangle: the render number that already rasterized it.
+    visited: Vec<u32>,
+    /// Per source triangle: the render number that copied its pieces for re-shading.
+    reshade_at: Vec<u32>,
+    number: u32,
+    /// The view id and trial serial whose render the buffers hold.
+    owner: Option<(u64, u32)>,
+}
+
+impl Default for Scratch {
+    fn default() -> Self {
+        Scratch {
+            samples: TileSamples::new([0, 0, 1, 1], 1, false),
+            pixels: Vec::new(),
+            shown: Vec::new(),
+            stamp: Vec::new(),
+            first_piece: Vec::new(),
+            visited: Vec::new(),
+            reshade_at: Vec::new(),
+            number: 0,
+            owner: None,
+        }
+    }
+}
+
+thread_local! {
+    static SCRATCH: std::cell::RefCell<Scratch> = std::cell::RefCell::new(Scratch::default());
+}
+
+/// Run `f` with this thread's scratch.
+fn with_scratch<R>(f: impl FnOnce(&mut Scratch) -> R) -> R {
+    SCRATCH.with_borrow_mut(f)
+}
+
+/// Source of view ids (unique in the process).
+static NEXT_VIEW_ID: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
 
 /// What a trial changed: every triangle whose corners, corner positions or corner attributes
 /// differ from the committed state (including triangles that died or were born), the vertices
@@ -393,6 +461,7 @@ impl LumaViews {
                         }
                         px
                     },
+                    id: NEXT_VIEW_ID.fetch_add(1, std::sync::atomic::Ordering::Relaxed),
                     trial: Trial::default(),
                 }
             })
@@ -411,8 +480,10 @@ impl LumaViews {
         let wm = &wedge_material;
         let compare_with_self = targets.is_none();
         views.par_iter_mut().for_each(|v| {
-            v.trial(shared_ref, mesh, wm, &change, true);
-            v.commit(shared_ref);
+            with_scratch(|s| {
+                v.trial(shared_ref, mesh, wm, &change, true, s);
+                v.commit(shared_ref, mesh, s);
+            });
             if compare_with_self {
                 v.px.iter_mut().for_each(|p| p.target = p.current);
             }
@@ -496,17 +567,19 @@ impl LumaViews {
         let wm = &self.wedge_material;
         self.views
             .par_iter_mut()
-            .map(|v| v.trial(shared, mesh, wm, change, false))
+            .map(|v| with_scratch(|s| v.trial(shared, mesh, wm, change, false, s)))
             .sum()
     }
 
-    /// Make the pending trial the committed state.
-    pub fn commit(&mut self) {
+    /// Make the pending trial the committed state; `mesh` must be the mesh of the trial.
+    pub fn commit(&mut self, mesh: &Adjacency) {
         if !std::mem::take(&mut self.pending) {
             return;
         }
         let shared = &self.shared;
-        self.views.par_iter_mut().for_each(|v| v.commit(shared));
+        self.views
+            .par_iter_mut()
+            .for_each(|v| with_scratch(|s| v.commit(shared, mesh, s)));
     }
 
     /// Drop the pending trial.
@@ -524,6 +597,31 @@ fn sq(t: u16, y: u16) -> i64 {
     d * d
 }
 
+/// Ask for the cache lines of `rect`'s pixels in row-major `px` (`w` per row) at once: every
+/// view's images are cold when its turn comes, and rows fetched one miss at a time were most of
+/// a trial's time.
+fn prefetch_rect<T>(px: &[T], w: usize, [x0, y0, x1, y1]: [i32; 4]) {
+    #[cfg(target_arch = "x86_64")]
+    {
+        use std::arch::x86_64::{_MM_HINT_T0, _mm_prefetch};
+        let line = 64 / std::mem::size_of::<T>().max(1);
+        for y in y0..y1 {
+            let row = y as usize * w;
+            let (a, b) = (row + x0 as usize, row + x1 as usize);
+            let mut i = a;
+            while i < b {
+                // SAFETY: a prefetch is a hint; the address is within `px`.
+                unsafe { _mm_prefetch(px.as_ptr().add(i) as *const i8, _MM_HINT_T0) };
+                i += line;
+            }
+            // The row's last line, when the stride skipped it.
+            unsafe { _mm_prefetch(px.as_ptr().add(b - 1) as *const i8, _MM_HINT_T0) };
+        }
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    let _ = (px, w, x0, y0, x1, y1);
+}
+
 /// Bucket tiles (row-major, `tiles_x` per row) overlapped by a pixel rectangle.
 fn tiles(tiles_x: u32, r: [i32; 4]) -> impl Iterator<Item = usize> {
     let b = BUCKET as i32;
@@ -532,7 +630,31 @@ fn tiles(tiles_x: u32, r: [i32; 4]) -> impl Iterator<Item = usize> {
     (y0..=y1).flat_map(move |y| (x0..=x1).map(move |x| y as usize * tx + x as usize))
 }
 
+impl Scratch {
+    /// A fresh trial number for stamping `slots` source triangles.
+    fn next_number(&mut self, slots: usize) -> u32 {
+        if self.stamp.len() < slots {
+            self.stamp.resize(slots, 0);
+            self.first_piece.resize(slots, 0);
+            self.visited.resize(slots, 0);
+            self.reshade_at.resize(slots, 0);
+        }
+        self.number = (self.number + 1) & !RESHADE;
+        if self.number == 0 {
+            // Wrapped: forget every old stamp.
+            self.stamp.iter_mut().for_each(|s| *s = 0);
+            self.visited.iter_mut().for_each(|s| *s = 0);
+            self.reshade_at.iter_mut().for_each(|s| *s = 0);
+            self.number = 1;
+        }
+        self.owner = None;
+        self.number
+    }
+}
+
 impl View {
+    /// Apply `change` to this view's transforms, light terms and set-up (saving what a revert
+    /// restores), then render the dirty rectangle into `scratch` and return ΔE.
     fn trial(
         &mut self,
         shared: &Shared,
@@ -540,20 +662,15 @@ impl View {
         wedge_material: &[u32],
         change: &Change,
         everything: bool,
+        scratch: &mut Scratch,
     ) -> i64 {
         let tr = &mut self.trial;
-        tr.number = (tr.number + 1) & !RESHADE;
-        if tr.number == 0 {
-            // Wrapped: forget every old stamp.
-            tr.stamp.iter_mut().for_each(|s| *s = 0);
-            tr.visited.iter_mut().for_each(|s| *s = 0);
-            tr.reshade_at.iter_mut().for_each(|s| *s = 0);
-            tr.number = 1;
-        }
+        tr.serial = tr.serial.wrapping_add(1);
         tr.saved_xf.clear();
         tr.saved_light.clear();
         tr.pieces.clear();
         tr.bbox.clear();
+        tr.reshaded.clear();
         tr.rect = None;
         // New vertex transforms and wedge light terms (old values saved for a revert).
         let grow = |len: &mut usize, need: usize| *len = (*len).max(need);
@@ -595,18 +712,10 @@ impl View {
             }
         }
         // New set-up of the changed triangles; the old and new boxes make the dirty rectangle.
-        let slots = mesh.triangle_slots().max(self.pieces.len());
-        if tr.stamp.len() < slots {
-            tr.stamp.resize(slots, 0);
-            tr.first_piece.resize(slots, 0);
-            tr.visited.resize(slots, 0);
-            tr.reshade_at.resize(slots, 0);
-        }
-        let number = tr.number;
+        let number = scratch.next_number(mesh.triangle_slots().max(self.pieces.len()));
         let mut rect: Option<[i32; 4]> = None;
         for &t in change.triangles {
-            tr.stamp[t as usize] = number;
-            tr.first_piece[t as usize] = tr.pieces.len() as u32;
+            scratch.stamp[t as usize] = number;
             if let Some(Some(b)) = self.bbox.get(t as usize) {
                 rect = Some(union(rect, *b));
             }
@@ -642,12 +751,10 @@ impl View {
         }
         tr.changed_pieces = tr.pieces.len();
         // Triangles that only need shading anew (their wedges changed, not their corners).
-        let reshade = number | RESHADE;
-        tr.reshaded.clear();
         for &t in change.reshaded {
             let tu = t as usize;
-            if tr.stamp[tu] != number && tr.stamp[tu] != reshade {
-                tr.stamp[tu] = reshade;
+            if scratch.stamp[tu] != number {
+                scratch.stamp[tu] = number;
                 tr.reshaded.push(t);
                 if let Some(&Some(b)) = self.bbox.get(tu) {
                     rect = Some(union(rect, b));
@@ -657,21 +764,53 @@ impl View {
         let Some(rect) = rect else {
             return 0;
         };
-        let rect = if everything {
+        tr.rect = Some(if everything {
             [0, 0, shared.width as i32, shared.height as i32]
         } else {
             rect
+        });
+        self.render(shared, mesh, scratch)
+    }
+
+    /// Render the pending trial's rectangle into `scratch` (its depth, winners and luminance)
+    /// and return ΔE. A function of the view's state alone, so [`View::commit`] can run it again
+    /// when `scratch` has since served another view.
+    fn render(&mut self, shared: &Shared, mesh: &Adjacency, scratch: &mut Scratch) -> i64 {
+        let tr = &mut self.trial;
+        let Some(rect) = tr.rect else {
+            return 0;
         };
-        tr.rect = Some(rect);
+        let number = scratch.next_number(mesh.triangle_slots().max(self.pieces.len()));
+        let reshade = number | RESHADE;
+        tr.pieces.truncate(tr.changed_pieces);
+        for (k, &(t, _)) in tr.pieces.iter().enumerate() {
+            if k == 0 || tr.pieces[k - 1].0 != t {
+                scratch.first_piece[t as usize] = k as u32;
+            }
+        }
+        for &(t, _) in &tr.bbox {
+            scratch.stamp[t as usize] = number;
+        }
+        for &t in &tr.reshaded {
+            scratch.stamp[t as usize] = reshade;
+        }
+        let Scratch {
+            samples,
+            pixels,
+            shown: new_shown,
+            stamp,
+            first_piece,
+            visited,
+            reshade_at,
+            ..
+        } = scratch;
         // Start from the committed depth and winners; where a changed triangle won, a hole opens
         // that only the unchanged triangles below it can fill.
-        let samples = tr
-            .samples
-            .get_or_insert_with(|| TileSamples::new([0, 0, 1, 1], 1, false));
         samples.resize_for(rect);
         samples.lowest_id_wins_ties = true;
         let [x0, y0, x1, y1] = rect;
         let w = shared.width as usize;
+        prefetch_rect(&self.px, w, rect);
         let mut holes: Option<[i32; 4]> = None;
         for y in y0..y1 {
             let row = (y - y0) as usize * (x1 - x0) as usize;
@@ -679,7 +818,7 @@ impl View {
                 let i = y as usize * w + x as usize;
                 let Pixel { shown, depth, .. } = self.px[i];
                 let k = row + (x - x0) as usize;
-                if shown != EMPTY && tr.stamp[(shown >> PIECE_BITS) as usize] == number {
+                if shown != EMPTY && stamp[(shown >> PIECE_BITS) as usize] == number {
                     holes = Some(union(holes, [x, y, x + 1, y + 1]));
                     samples.depth[k] = f32::INFINITY;
                     samples.ids[k] = EMPTY;
@@ -690,48 +829,40 @@ impl View {
             }
         }
         let offsets = [[fixed::ONE_PIXEL / 2, fixed::ONE_PIXEL / 2]];
-        let mut scratch = [[0i64; 3]; 1];
+        let mut sample_scratch = [[0i64; 3]; 1];
         if let Some(h) = holes {
             // The unchanged triangles overlapping the holes (through the buckets), each once.
             let overlaps = |b: [i32; 4]| b[0] < h[2] && h[0] < b[2] && b[1] < h[3] && h[1] < b[3];
             for tile in tiles(self.tiles_x, h) {
-                for &t in &self.buckets[tile] {
-                    let tu = t as usize;
-                    if tr.stamp[tu] == number || tr.visited[tu] == number {
+                for entry in &self.buckets[tile] {
+                    if !entry.overlaps(h) {
                         continue;
                     }
-                    tr.visited[tu] = number;
+                    let (t, tu) = (entry.tri, entry.tri as usize);
+                    if stamp[tu] == number || visited[tu] == number {
+                        continue;
+                    }
+                    visited[tu] = number;
                     for (k, p) in self.pieces[tu].iter().enumerate() {
                         if overlaps(p.st.bbox()) {
                             let id = (t << PIECE_BITS) | k as u32;
-                            edge::rasterize(&p.st, id, &offsets, h, samples, &mut scratch);
+                            edge::rasterize(&p.st, id, &offsets, h, samples, &mut sample_scratch);
                         }
                     }
                 }
             }
         }
         // The changed triangles' new pieces.
-        let mut k = 0;
-        while k < tr.changed_pieces {
-            let t = tr.pieces[k].0;
-            let first = tr.first_piece[t as usize] as usize;
-            let id = (t << PIECE_BITS) | (k - first) as u32;
-            edge::rasterize(
-                &tr.pieces[k].1.st,
-                id,
-                &offsets,
-                rect,
-                samples,
-                &mut scratch,
-            );
-            k += 1;
+        for (k, (t, p)) in tr.pieces.iter().enumerate() {
+            let id = (t << PIECE_BITS) | (k as u32 - first_piece[*t as usize]);
+            edge::rasterize(&p.st, id, &offsets, rect, samples, &mut sample_scratch);
         }
         // Shade and compare. A pixel that still shows the same piece of an unchanged triangle
         // keeps its value (its corners and attributes are as committed); only pixels showing a
         // changed or re-shaded triangle, or another piece than before, are shaded.
         let n_rect = ((x1 - x0) * (y1 - y0)) as usize;
-        tr.pixels.resize(n_rect, 0);
-        tr.shown.resize(n_rect, 0);
+        pixels.resize(n_rect, 0);
+        new_shown.resize(n_rect, 0);
         let mut delta = 0i64;
         for y in y0..y1 {
             for x in x0..x1 {
@@ -743,24 +874,24 @@ impl View {
                     shared.background
                 } else {
                     let t = id >> PIECE_BITS;
-                    let stamp = tr.stamp[t as usize];
-                    if id == old.shown && stamp != number && stamp != reshade {
+                    let s = stamp[t as usize];
+                    if id == old.shown && s != number && s != reshade {
                         old.current
                     } else {
                         let (piece, tu) = ((id & PIECE_MASK) as usize, t as usize);
-                        let p = if stamp == number {
-                            &mut tr.pieces[tr.first_piece[tu] as usize + piece].1
-                        } else if stamp == reshade {
+                        let p = if s == number {
+                            &mut tr.pieces[first_piece[tu] as usize + piece].1
+                        } else if s == reshade {
                             // Its geometry as committed, its shading anew.
-                            if tr.reshade_at[tu] != number {
-                                tr.reshade_at[tu] = number;
-                                tr.first_piece[tu] = tr.pieces.len() as u32;
+                            if reshade_at[tu] != number {
+                                reshade_at[tu] = number;
+                                first_piece[tu] = tr.pieces.len() as u32;
                                 for p in &self.pieces[tu] {
                                     let shading = PieceShading::Unknown;
                                     tr.pieces.push((t, Piece { shading, ..*p }));
                                 }
                             }
-                            &mut tr.pieces[tr.first_piece[tu] as usize + piece].1
+                            &mut tr.pieces[first_piece[tu] as usize + piece].1
                         } else {
                             &mut self.pieces[tu][piece]
                         };
@@ -773,14 +904,20 @@ impl View {
                     }
                 };
                 delta += sq(old.target, luma) - sq(old.target, old.current);
-                tr.pixels[k] = luma;
-                tr.shown[k] = id;
+                pixels[k] = luma;
+                new_shown[k] = id;
             }
         }
+        scratch.owner = Some((self.id, tr.serial));
         delta
     }
 
-    fn commit(&mut self, shared: &Shared) {
+    /// Make the pending trial the committed state (rendering it again if `scratch` no longer
+    /// holds it).
+    fn commit(&mut self, shared: &Shared, mesh: &Adjacency, scratch: &mut Scratch) {
+        if self.trial.rect.is_some() && scratch.owner != Some((self.id, self.trial.serial)) {
+            self.render(shared, mesh, scratch);
+        }
         let tr = &mut self.trial;
         // Pieces and buckets of the changed triangles.
         let mut k = 0;
@@ -791,7 +928,7 @@ impl View {
                 self.bbox.resize(t_us + 1, None);
             }
             self.pieces[t_us].clear();
-            while k < tr.pieces.len() && tr.pieces[k].0 == t {
+            while k < tr.changed_pieces && tr.pieces[k].0 == t {
                 self.pieces[t_us].push(tr.pieces[k].1);
                 k += 1;
             }
@@ -800,34 +937,33 @@ impl View {
                 if let Some(o) = old {
                     for tile in tiles(self.tiles_x, o) {
                         let list = &mut self.buckets[tile];
-                        if let Some(p) = list.iter().position(|&x| x == t) {
+                        if let Some(p) = list.iter().position(|e| e.tri == t) {
                             list.swap_remove(p);
                         }
                     }
                 }
                 if let Some(n) = bb {
                     for tile in tiles(self.tiles_x, n) {
-                        self.buckets[tile].push(t);
+                        self.buckets[tile].push(BucketEntry::new(t, n));
                     }
                 }
                 self.bbox[t_us] = bb;
             }
         }
-        for &t in &self.trial.reshaded {
+        for &t in &tr.reshaded {
             for p in self.pieces.get_mut(t as usize).into_iter().flatten() {
                 p.shading = PieceShading::Unknown;
             }
         }
-        let tr = &mut self.trial;
-        if let (Some([x0, y0, x1, y1]), Some(samples)) = (tr.rect, &tr.samples) {
+        if let Some([x0, y0, x1, y1]) = tr.rect {
             let (w, rw) = (shared.width as usize, (x1 - x0) as usize);
             for (row, y) in (y0..y1).enumerate() {
                 let dst = y as usize * w + x0 as usize;
                 let src = row * rw..(row + 1) * rw;
-                let new = tr.pixels[src.clone()]
+                let new = scratch.pixels[src.clone()]
                     .iter()
-                    .zip(&tr.shown[src.clone()])
-                    .zip(&samples.depth[src]);
+                    .zip(&scratch.shown[src.clone()])
+                    .zip(&scratch.samples.depth[src]);
                 for (p, ((&current, &shown), &depth)) in self.px[dst..dst + rw].iter_mut().zip(new)
                 {
                     (p.current, p.shown, p.depth) = (current, shown, depth);
@@ -851,6 +987,7 @@ impl View {
         tr.saved_light.clear();
         tr.pieces.clear();
         tr.bbox.clear();
+        tr.reshaded.clear();
         tr.rect = None;
     }
 }
@@ -978,7 +1115,7 @@ mod tests {
             reshaded: &[],
         };
         let delta = views.trial(&adj, &change);
-        views.commit();
+        views.commit(&adj);
         let full = LumaViews::new(&adj, &scene, &cams, 64, 64, Some(targets)).unwrap();
         assert_eq!(views.images(), full.images());
         assert_eq!(e0 + delta, full.energy());

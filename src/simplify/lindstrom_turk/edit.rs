@@ -153,7 +153,7 @@ impl State {
 
     /// Accept the pending trial: commit the images and the energy.
     pub fn accept(&mut self, delta: i64) {
-        self.views.commit();
+        self.views.commit(&self.adj);
         self.energy += delta;
         self.begin();
     }
