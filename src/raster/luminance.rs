@@ -252,6 +252,8 @@ struct Scratch {
     visited: Vec<u32>,
     /// Per source triangle: the render number that copied its pieces for re-shading.
     reshade_at: Vec<u32>,
+    /// Unchanged triangles that may fill the holes.
+    candidates: Vec<u32>,
     number: u32,
     /// The view id and trial serial whose render the buffers hold.
     owner: Option<(u64, u32)>,
@@ -267,6 +269,7 @@ impl Default for Scratch {
             first_piece: Vec::new(),
             visited: Vec::new(),
             reshade_at: Vec::new(),
+            candidates: Vec::new(),
             number: 0,
             owner: None,
         }
@@ -597,29 +600,45 @@ fn sq(t: u16, y: u16) -> i64 {
     d * d
 }
 
+/// Ask for the cache line of `v[i]`, if there is one.
+#[inline]
+fn prefetch_at<T>(v: &[T], i: u32) {
+    if let Some(x) = v.get(i as usize) {
+        prefetch(x);
+    }
+}
+
+/// Ask for the cache line holding `x`.
+#[inline]
+fn prefetch<T>(x: *const T) {
+    #[cfg(target_arch = "x86_64")]
+    // SAFETY: a prefetch is a hint and never faults.
+    unsafe {
+        use std::arch::x86_64::{_MM_HINT_T0, _mm_prefetch};
+        _mm_prefetch(x as *const i8, _MM_HINT_T0)
+    };
+    #[cfg(not(target_arch = "x86_64"))]
+    let _ = x;
+}
+
 /// Ask for the cache lines of `rect`'s pixels in row-major `px` (`w` per row) at once: every
 /// view's images are cold when its turn comes, and rows fetched one miss at a time were most of
 /// a trial's time.
 fn prefetch_rect<T>(px: &[T], w: usize, [x0, y0, x1, y1]: [i32; 4]) {
-    #[cfg(target_arch = "x86_64")]
     {
-        use std::arch::x86_64::{_MM_HINT_T0, _mm_prefetch};
         let line = 64 / std::mem::size_of::<T>().max(1);
         for y in y0..y1 {
             let row = y as usize * w;
             let (a, b) = (row + x0 as usize, row + x1 as usize);
             let mut i = a;
             while i < b {
-                // SAFETY: a prefetch is a hint; the address is within `px`.
-                unsafe { _mm_prefetch(px.as_ptr().add(i) as *const i8, _MM_HINT_T0) };
+                prefetch(&px[i]);
                 i += line;
             }
             // The row's last line, when the stride skipped it.
-            unsafe { _mm_prefetch(px.as_ptr().add(b - 1) as *const i8, _MM_HINT_T0) };
+            prefetch(&px[b - 1]);
         }
     }
-    #[cfg(not(target_arch = "x86_64"))]
-    let _ = (px, w, x0, y0, x1, y1);
 }
 
 /// Bucket tiles (row-major, `tiles_x` per row) overlapped by a pixel rectangle.
@@ -672,6 +691,24 @@ impl View {
         tr.bbox.clear();
         tr.reshaded.clear();
         tr.rect = None;
+        // Everything below gathers from this view's cold per-vertex, per-wedge and per-triangle
+        // arrays: ask for all of it first.
+        change
+            .vertices
+            .iter()
+            .for_each(|&v| prefetch_at(&self.xf, v));
+        change
+            .wedges
+            .iter()
+            .for_each(|&w| prefetch_at(&self.light, w));
+        change
+            .triangles
+            .iter()
+            .for_each(|&t| prefetch_at(&self.bbox, t));
+        change
+            .reshaded
+            .iter()
+            .for_each(|&t| prefetch_at(&self.bbox, t));
         // New vertex transforms and wedge light terms (old values saved for a revert).
         let grow = |len: &mut usize, need: usize| *len = (*len).max(need);
         let mut nv = self.xf.len();
@@ -802,6 +839,7 @@ impl View {
             first_piece,
             visited,
             reshade_at,
+            candidates,
             ..
         } = scratch;
         // Start from the committed depth and winners; where a changed triangle won, a hole opens
@@ -833,21 +871,28 @@ impl View {
         if let Some(h) = holes {
             // The unchanged triangles overlapping the holes (through the buckets), each once.
             let overlaps = |b: [i32; 4]| b[0] < h[2] && h[0] < b[2] && b[1] < h[3] && h[1] < b[3];
+            // Gathered first and their pieces prefetched, so the misses overlap.
+            candidates.clear();
             for tile in tiles(self.tiles_x, h) {
                 for entry in &self.buckets[tile] {
-                    if !entry.overlaps(h) {
-                        continue;
+                    let tu = entry.tri as usize;
+                    if entry.overlaps(h) && stamp[tu] != number && visited[tu] != number {
+                        visited[tu] = number;
+                        candidates.push(entry.tri);
+                        prefetch_at(&self.pieces, entry.tri);
                     }
-                    let (t, tu) = (entry.tri, entry.tri as usize);
-                    if stamp[tu] == number || visited[tu] == number {
-                        continue;
-                    }
-                    visited[tu] = number;
-                    for (k, p) in self.pieces[tu].iter().enumerate() {
-                        if overlaps(p.st.bbox()) {
-                            let id = (t << PIECE_BITS) | k as u32;
-                            edge::rasterize(&p.st, id, &offsets, h, samples, &mut sample_scratch);
-                        }
+                }
+            }
+            for &t in candidates.iter() {
+                if let Some(p) = self.pieces[t as usize].first() {
+                    prefetch(p);
+                }
+            }
+            for &t in candidates.iter() {
+                for (k, p) in self.pieces[t as usize].iter().enumerate() {
+                    if overlaps(p.st.bbox()) {
+                        let id = (t << PIECE_BITS) | k as u32;
+                        edge::rasterize(&p.st, id, &offsets, h, samples, &mut sample_scratch);
                     }
                 }
             }
