@@ -169,6 +169,10 @@ struct View {
     tiles_x: u32,
     /// The committed image, row-major.
     px: Vec<Pixel>,
+    /// Per source triangle: how many pixels show it.
+    shown_count: Vec<u32>,
+    /// Per bucket tile: the farthest committed depth in it (infinite where background shows).
+    tile_far: Vec<f32>,
     /// Unique in the process: names the scratch contents with the trial serial.
     id: u64,
     trial: Trial,
@@ -464,6 +468,8 @@ impl LumaViews {
                         }
                         px
                     },
+                    shown_count: Vec::new(),
+                    tile_far: vec![f32::INFINITY; n_tiles],
                     id: NEXT_VIEW_ID.fetch_add(1, std::sync::atomic::Ordering::Relaxed),
                     trial: Trial::default(),
                 }
@@ -641,6 +647,22 @@ fn prefetch_rect<T>(px: &[T], w: usize, [x0, y0, x1, y1]: [i32; 4]) {
     }
 }
 
+/// Whether triangle `t` shows in any committed pixel, by the view's per-triangle counts.
+#[inline]
+fn shows(shown_count: &[u32], t: u32) -> bool {
+    shown_count.get(t as usize).is_some_and(|&c| c > 0)
+}
+
+/// Whether set-up triangle `st` is farther than every committed pixel in the tiles its box
+/// touches (`tile_far`: the farthest depth per tile), so it can win no depth test against them.
+fn hidden(tile_far: &[f32], tiles_x: u32, st: &SetupTri) -> bool {
+    // Interpolated depths are rounded once from f64 and so stay within a relative 1e-6 of the
+    // corners' range.
+    let near = st.z[0].min(st.z[1]).min(st.z[2]);
+    let near = near - near.abs() * 1e-6 - 1e-7;
+    tiles(tiles_x, st.bbox()).all(|tile| near > tile_far[tile])
+}
+
 /// Bucket tiles (row-major, `tiles_x` per row) overlapped by a pixel rectangle.
 fn tiles(tiles_x: u32, r: [i32; 4]) -> impl Iterator<Item = usize> {
     let b = BUCKET as i32;
@@ -701,14 +723,10 @@ impl View {
             .wedges
             .iter()
             .for_each(|&w| prefetch_at(&self.light, w));
-        change
-            .triangles
-            .iter()
-            .for_each(|&t| prefetch_at(&self.bbox, t));
-        change
-            .reshaded
-            .iter()
-            .for_each(|&t| prefetch_at(&self.bbox, t));
+        for &t in change.triangles.iter().chain(change.reshaded) {
+            prefetch_at(&self.bbox, t);
+            prefetch_at(&self.shown_count, t);
+        }
         // New vertex transforms and wedge light terms (old values saved for a revert).
         let grow = |len: &mut usize, need: usize| *len = (*len).max(need);
         let mut nv = self.xf.len();
@@ -750,11 +768,17 @@ impl View {
         }
         // New set-up of the changed triangles; the old and new boxes make the dirty rectangle.
         let number = scratch.next_number(mesh.triangle_slots().max(self.pieces.len()));
+        // The pixels that can change: those showing a changed or re-shaded triangle now (its
+        // old box, when it shows at all) and those a new piece covers.
         let mut rect: Option<[i32; 4]> = None;
+        let mut shows_now = false;
         for &t in change.triangles {
             scratch.stamp[t as usize] = number;
-            if let Some(Some(b)) = self.bbox.get(t as usize) {
+            if let Some(Some(b)) = self.bbox.get(t as usize)
+                && shows(&self.shown_count, t)
+            {
                 rect = Some(union(rect, *b));
+                shows_now = true;
             }
             let mut bb: Option<[i32; 4]> = None;
             if mesh.is_alive(t) {
@@ -781,9 +805,6 @@ impl View {
                     bb = Some(union(bb, st.bbox()));
                 }
             }
-            if let Some(b) = bb {
-                rect = Some(union(rect, b));
-            }
             tr.bbox.push((t, bb));
         }
         tr.changed_pieces = tr.pieces.len();
@@ -793,9 +814,20 @@ impl View {
             if scratch.stamp[tu] != number {
                 scratch.stamp[tu] = number;
                 tr.reshaded.push(t);
-                if let Some(&Some(b)) = self.bbox.get(tu) {
+                if let Some(&Some(b)) = self.bbox.get(tu)
+                    && shows(&self.shown_count, t)
+                {
                     rect = Some(union(rect, b));
+                    shows_now = true;
                 }
+            }
+        }
+        // Where nothing that changed shows now, the committed depths stay, and a new piece
+        // behind all of them in every tile it touches (the far side of a closed mesh) cannot
+        // change a pixel: the view then often has nothing to render at all.
+        for (_, p) in &tr.pieces {
+            if shows_now || !hidden(&self.tile_far, self.tiles_x, &p.st) {
+                rect = Some(union(rect, p.st.bbox()));
             }
         }
         let Some(rect) = rect else {
@@ -1000,8 +1032,12 @@ impl View {
                 p.shading = PieceShading::Unknown;
             }
         }
-        if let Some([x0, y0, x1, y1]) = tr.rect {
+        if let Some(rect @ [x0, y0, x1, y1]) = tr.rect {
             let (w, rw) = (shared.width as usize, (x1 - x0) as usize);
+            if self.shown_count.len() < self.pieces.len() {
+                self.shown_count.resize(self.pieces.len(), 0);
+            }
+            let count = &mut self.shown_count;
             for (row, y) in (y0..y1).enumerate() {
                 let dst = y as usize * w + x0 as usize;
                 let src = row * rw..(row + 1) * rw;
@@ -1011,8 +1047,33 @@ impl View {
                     .zip(&scratch.samples.depth[src]);
                 for (p, ((&current, &shown), &depth)) in self.px[dst..dst + rw].iter_mut().zip(new)
                 {
+                    if p.shown != shown {
+                        if p.shown != EMPTY {
+                            count[(p.shown >> PIECE_BITS) as usize] -= 1;
+                        }
+                        if shown != EMPTY {
+                            count[(shown >> PIECE_BITS) as usize] += 1;
+                        }
+                    }
                     (p.current, p.shown, p.depth) = (current, shown, depth);
                 }
+            }
+            // The farthest depth of every tile the rectangle touched.
+            let b = BUCKET as i32;
+            let (wi, hi) = (shared.width as i32, shared.height as i32);
+            for tile in tiles(self.tiles_x, rect) {
+                let (tx, ty) = (
+                    (tile as u32 % self.tiles_x) as i32,
+                    (tile as u32 / self.tiles_x) as i32,
+                );
+                let mut far = f32::NEG_INFINITY;
+                for y in ty * b..((ty + 1) * b).min(hi) {
+                    let row = y as usize * w;
+                    for x in tx * b..((tx + 1) * b).min(wi) {
+                        far = far.max(self.px[row + x as usize].depth);
+                    }
+                }
+                self.tile_far[tile] = far;
             }
         }
         tr.saved_xf.clear();
