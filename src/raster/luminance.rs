@@ -225,6 +225,19 @@ struct Trial {
     serial: u32,
     saved_xf: Vec<(u32, XfVertex)>,
     saved_light: Vec<(u32, (Vec3, Vec3))>,
+    /// The changed triangles (see [`Change::triangles`]).
+    triangles: Vec<u32>,
+    /// The re-shaded triangles (see [`Change::reshaded`]).
+    reshaded: Vec<u32>,
+    /// Whether the whole image is rendered (the first render).
+    everything: bool,
+}
+
+/// Per-thread working memory of a trial: the new pieces, the rectangle's samples and luminance
+/// and the per-triangle stamps. Shared by every view a thread renders, so it stays in cache
+/// (per-view buffers were cold at every trial, each view's turn coming after nineteen others).
+#[derive(Debug)]
+struct Scratch {
     /// New pieces: those of the changed triangles (grouped by triangle, in `bbox`'s order), then
     /// copies of re-shaded triangles' pieces made while shading.
     pieces: Vec<(u32, Piece)>,
@@ -232,18 +245,9 @@ struct Trial {
     changed_pieces: usize,
     /// Changed triangles and their new boxes.
     bbox: Vec<(u32, Option<[i32; 4]>)>,
-    /// Re-shaded triangles (their committed pieces' shading is forgotten on commit).
-    reshaded: Vec<u32>,
     /// The dirty rectangle (`None`: nothing to render).
     rect: Option<[i32; 4]>,
     setup: SetupOut,
-}
-
-/// Per-thread working memory of a trial's render: the rectangle's samples and luminance and the
-/// per-triangle stamps. Shared by every view a thread renders, so it stays in cache (per-view
-/// buffers were cold at every trial, each view's turn coming after nineteen others).
-#[derive(Debug)]
-struct Scratch {
     samples: TileSamples,
     pixels: Vec<u16>,
     shown: Vec<u32>,
@@ -266,6 +270,11 @@ struct Scratch {
 impl Default for Scratch {
     fn default() -> Self {
         Scratch {
+            pieces: Vec::new(),
+            changed_pieces: 0,
+            bbox: Vec::new(),
+            rect: None,
+            setup: SetupOut::default(),
             samples: TileSamples::new([0, 0, 1, 1], 1, false),
             pixels: Vec::new(),
             shown: Vec::new(),
@@ -709,10 +718,11 @@ impl View {
         tr.serial = tr.serial.wrapping_add(1);
         tr.saved_xf.clear();
         tr.saved_light.clear();
-        tr.pieces.clear();
-        tr.bbox.clear();
+        tr.triangles.clear();
+        tr.triangles.extend_from_slice(change.triangles);
         tr.reshaded.clear();
-        tr.rect = None;
+        tr.reshaded.extend_from_slice(change.reshaded);
+        tr.everything = everything;
         // Everything below gathers from this view's cold per-vertex, per-wedge and per-triangle
         // arrays: ask for all of it first.
         change
@@ -766,13 +776,35 @@ impl View {
                 );
             }
         }
-        // New set-up of the changed triangles; the old and new boxes make the dirty rectangle.
+        self.build(shared, mesh, scratch)
+    }
+
+    /// Set up the pending trial's changed triangles and render its rectangle into `scratch`;
+    /// return ΔE. A function of the view's state alone, so [`View::commit`] can run it again
+    /// when `scratch` has since served another view.
+    fn build(&mut self, shared: &Shared, mesh: &Adjacency, scratch: &mut Scratch) -> i64 {
+        let delta = if self.prepare(shared, mesh, scratch) {
+            self.render(shared, mesh, scratch)
+        } else {
+            0
+        };
+        scratch.owner = Some((self.id, self.trial.serial));
+        delta
+    }
+
+    /// New set-up of the changed triangles and the dirty rectangle; false if it is empty.
+    fn prepare(&self, shared: &Shared, mesh: &Adjacency, scratch: &mut Scratch) -> bool {
+        let tr = &self.trial;
         let number = scratch.next_number(mesh.triangle_slots().max(self.pieces.len()));
+        let reshade = number | RESHADE;
+        scratch.pieces.clear();
+        scratch.bbox.clear();
+        scratch.rect = None;
         // The pixels that can change: those showing a changed or re-shaded triangle now (its
         // old box, when it shows at all) and those a new piece covers.
         let mut rect: Option<[i32; 4]> = None;
         let mut shows_now = false;
-        for &t in change.triangles {
+        for &t in &tr.triangles {
             scratch.stamp[t as usize] = number;
             if let Some(Some(b)) = self.bbox.get(t as usize)
                 && shows(&self.shown_count, t)
@@ -782,19 +814,13 @@ impl View {
             }
             let mut bb: Option<[i32; 4]> = None;
             if mesh.is_alive(t) {
-                tr.setup.tris.clear();
-                tr.setup.clipped.clear();
-                setup_one(
-                    t,
-                    mesh.triangle(t),
-                    &self.xf,
-                    &self.planes,
-                    self.vp,
-                    &mut tr.setup,
-                );
-                for st in &tr.setup.tris {
-                    let corners = super::setup::Corners::decode(st.corners, &tr.setup.clipped);
-                    tr.pieces.push((
+                let setup = &mut scratch.setup;
+                setup.tris.clear();
+                setup.clipped.clear();
+                setup_one(t, mesh.triangle(t), &self.xf, &self.planes, self.vp, setup);
+                for st in &setup.tris {
+                    let corners = super::setup::Corners::decode(st.corners, &setup.clipped);
+                    scratch.pieces.push((
                         t,
                         Piece {
                             st: *st,
@@ -805,15 +831,14 @@ impl View {
                     bb = Some(union(bb, st.bbox()));
                 }
             }
-            tr.bbox.push((t, bb));
+            scratch.bbox.push((t, bb));
         }
-        tr.changed_pieces = tr.pieces.len();
+        scratch.changed_pieces = scratch.pieces.len();
         // Triangles that only need shading anew (their wedges changed, not their corners).
-        for &t in change.reshaded {
+        for &t in &tr.reshaded {
             let tu = t as usize;
-            if scratch.stamp[tu] != number {
-                scratch.stamp[tu] = number;
-                tr.reshaded.push(t);
+            if scratch.stamp[tu] != number && scratch.stamp[tu] != reshade {
+                scratch.stamp[tu] = reshade;
                 if let Some(&Some(b)) = self.bbox.get(tu)
                     && shows(&self.shown_count, t)
                 {
@@ -825,45 +850,35 @@ impl View {
         // Where nothing that changed shows now, the committed depths stay, and a new piece
         // behind all of them in every tile it touches (the far side of a closed mesh) cannot
         // change a pixel: the view then often has nothing to render at all.
-        for (_, p) in &tr.pieces {
+        for (_, p) in &scratch.pieces {
             if shows_now || !hidden(&self.tile_far, self.tiles_x, &p.st) {
                 rect = Some(union(rect, p.st.bbox()));
             }
         }
-        let Some(rect) = rect else {
-            return 0;
-        };
-        tr.rect = Some(if everything {
-            [0, 0, shared.width as i32, shared.height as i32]
-        } else {
-            rect
-        });
-        self.render(shared, mesh, scratch)
-    }
-
-    /// Render the pending trial's rectangle into `scratch` (its depth, winners and luminance)
-    /// and return ΔE. A function of the view's state alone, so [`View::commit`] can run it again
-    /// when `scratch` has since served another view.
-    fn render(&mut self, shared: &Shared, mesh: &Adjacency, scratch: &mut Scratch) -> i64 {
-        let tr = &mut self.trial;
-        let Some(rect) = tr.rect else {
-            return 0;
-        };
-        let number = scratch.next_number(mesh.triangle_slots().max(self.pieces.len()));
-        let reshade = number | RESHADE;
-        tr.pieces.truncate(tr.changed_pieces);
-        for (k, &(t, _)) in tr.pieces.iter().enumerate() {
-            if k == 0 || tr.pieces[k - 1].0 != t {
+        let pieces = &scratch.pieces;
+        for (k, &(t, _)) in pieces.iter().enumerate() {
+            if k == 0 || pieces[k - 1].0 != t {
                 scratch.first_piece[t as usize] = k as u32;
             }
         }
-        for &(t, _) in &tr.bbox {
-            scratch.stamp[t as usize] = number;
-        }
-        for &t in &tr.reshaded {
-            scratch.stamp[t as usize] = reshade;
-        }
+        scratch.rect = if tr.everything {
+            Some([0, 0, shared.width as i32, shared.height as i32])
+        } else {
+            rect
+        };
+        scratch.rect.is_some()
+    }
+
+    /// Render the prepared rectangle into `scratch` (its depth, winners and luminance) and
+    /// return ΔE.
+    fn render(&mut self, shared: &Shared, mesh: &Adjacency, scratch: &mut Scratch) -> i64 {
+        let Some(rect) = scratch.rect else {
+            return 0;
+        };
+        let number = scratch.number;
+        let reshade = number | RESHADE;
         let Scratch {
+            pieces: new_pieces,
             samples,
             pixels,
             shown: new_shown,
@@ -872,6 +887,7 @@ impl View {
             visited,
             reshade_at,
             candidates,
+            changed_pieces,
             ..
         } = scratch;
         // Start from the committed depth and winners; where a changed triangle won, a hole opens
@@ -930,7 +946,7 @@ impl View {
             }
         }
         // The changed triangles' new pieces.
-        for (k, (t, p)) in tr.pieces.iter().enumerate() {
+        for (k, (t, p)) in new_pieces[..*changed_pieces].iter().enumerate() {
             let id = (t << PIECE_BITS) | (k as u32 - first_piece[*t as usize]);
             edge::rasterize(&p.st, id, &offsets, rect, samples, &mut sample_scratch);
         }
@@ -957,18 +973,18 @@ impl View {
                     } else {
                         let (piece, tu) = ((id & PIECE_MASK) as usize, t as usize);
                         let p = if s == number {
-                            &mut tr.pieces[first_piece[tu] as usize + piece].1
+                            &mut new_pieces[first_piece[tu] as usize + piece].1
                         } else if s == reshade {
                             // Its geometry as committed, its shading anew.
                             if reshade_at[tu] != number {
                                 reshade_at[tu] = number;
-                                first_piece[tu] = tr.pieces.len() as u32;
+                                first_piece[tu] = new_pieces.len() as u32;
                                 for p in &self.pieces[tu] {
                                     let shading = PieceShading::Unknown;
-                                    tr.pieces.push((t, Piece { shading, ..*p }));
+                                    new_pieces.push((t, Piece { shading, ..*p }));
                                 }
                             }
-                            &mut tr.pieces[first_piece[tu] as usize + piece].1
+                            &mut new_pieces[first_piece[tu] as usize + piece].1
                         } else {
                             &mut self.pieces[tu][piece]
                         };
@@ -985,28 +1001,27 @@ impl View {
                 new_shown[k] = id;
             }
         }
-        scratch.owner = Some((self.id, tr.serial));
         delta
     }
 
     /// Make the pending trial the committed state (rendering it again if `scratch` no longer
     /// holds it).
     fn commit(&mut self, shared: &Shared, mesh: &Adjacency, scratch: &mut Scratch) {
-        if self.trial.rect.is_some() && scratch.owner != Some((self.id, self.trial.serial)) {
-            self.render(shared, mesh, scratch);
+        if scratch.owner != Some((self.id, self.trial.serial)) {
+            self.build(shared, mesh, scratch);
         }
         let tr = &mut self.trial;
         // Pieces and buckets of the changed triangles.
         let mut k = 0;
-        for &(t, bb) in &tr.bbox {
+        for &(t, bb) in &scratch.bbox {
             let t_us = t as usize;
             if t_us >= self.pieces.len() {
                 self.pieces.resize(t_us + 1, Vec::new());
                 self.bbox.resize(t_us + 1, None);
             }
             self.pieces[t_us].clear();
-            while k < tr.changed_pieces && tr.pieces[k].0 == t {
-                self.pieces[t_us].push(tr.pieces[k].1);
+            while k < scratch.changed_pieces && scratch.pieces[k].0 == t {
+                self.pieces[t_us].push(scratch.pieces[k].1);
                 k += 1;
             }
             let old = self.bbox[t_us];
@@ -1032,7 +1047,7 @@ impl View {
                 p.shading = PieceShading::Unknown;
             }
         }
-        if let Some(rect @ [x0, y0, x1, y1]) = tr.rect {
+        if let Some(rect @ [x0, y0, x1, y1]) = scratch.rect {
             let (w, rw) = (shared.width as usize, (x1 - x0) as usize);
             if self.shown_count.len() < self.pieces.len() {
                 self.shown_count.resize(self.pieces.len(), 0);
@@ -1078,7 +1093,10 @@ impl View {
         }
         tr.saved_xf.clear();
         tr.saved_light.clear();
-        tr.rect = None;
+        tr.triangles.clear();
+        tr.reshaded.clear();
+        // What the scratch holds is committed now, not a pending trial.
+        scratch.owner = None;
     }
 
     fn revert(&mut self) {
@@ -1091,10 +1109,8 @@ impl View {
         }
         tr.saved_xf.clear();
         tr.saved_light.clear();
-        tr.pieces.clear();
-        tr.bbox.clear();
+        tr.triangles.clear();
         tr.reshaded.clear();
-        tr.rect = None;
     }
 }
 
