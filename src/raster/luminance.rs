@@ -27,6 +27,7 @@
 
 use glam::{Mat4, Vec2, Vec3};
 use rayon::prelude::*;
+use smallvec::SmallVec;
 
 use super::clip::ClipPlanes;
 use super::edge::{self, EMPTY, TileSamples};
@@ -163,7 +164,10 @@ struct View {
     xf: Vec<XfVertex>,
     /// Per wedge: Gouraud (diffuse, specular) light terms.
     light: Vec<(Vec3, Vec3)>,
-    pieces: Vec<Vec<Piece>>,
+    /// Per source triangle: its pieces, the first in place (a triangle is one piece unless
+    /// clipped, and a separate allocation per triangle was one more cache miss on every
+    /// triangle a trial touched).
+    pieces: Vec<SmallVec<[Piece; 1]>>,
     bbox: Vec<Option<[i32; 4]>>,
     buckets: Vec<Vec<BucketEntry>>,
     tiles_x: u32,
@@ -927,13 +931,11 @@ impl View {
                     if entry.overlaps(h) && stamp[tu] != number && visited[tu] != number {
                         visited[tu] = number;
                         candidates.push(entry.tri);
-                        prefetch_at(&self.pieces, entry.tri);
+                        // Its length and its first piece's set-up: two lines.
+                        let at = &self.pieces[tu] as *const SmallVec<[Piece; 1]> as *const u8;
+                        prefetch(at);
+                        prefetch(at.wrapping_add(64));
                     }
-                }
-            }
-            for &t in candidates.iter() {
-                if let Some(p) = self.pieces[t as usize].first() {
-                    prefetch(p);
                 }
             }
             for &t in candidates.iter() {
@@ -1016,7 +1018,7 @@ impl View {
         for &(t, bb) in &scratch.bbox {
             let t_us = t as usize;
             if t_us >= self.pieces.len() {
-                self.pieces.resize(t_us + 1, Vec::new());
+                self.pieces.resize(t_us + 1, SmallVec::new());
                 self.bbox.resize(t_us + 1, None);
             }
             self.pieces[t_us].clear();
