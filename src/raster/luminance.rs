@@ -242,11 +242,8 @@ struct Trial {
 /// (per-view buffers were cold at every trial, each view's turn coming after nineteen others).
 #[derive(Debug)]
 struct Scratch {
-    /// New pieces: those of the changed triangles (grouped by triangle, in `bbox`'s order), then
-    /// copies of re-shaded triangles' pieces made while shading.
+    /// New pieces of the changed triangles (grouped by triangle, in `bbox`'s order).
     pieces: Vec<(u32, Piece)>,
-    /// How many of `pieces` are the changed triangles' (the ones to rasterize).
-    changed_pieces: usize,
     /// Changed triangles and their new boxes.
     bbox: Vec<(u32, Option<[i32; 4]>)>,
     /// The dirty rectangle (`None`: nothing to render).
@@ -266,6 +263,8 @@ struct Scratch {
     reshade_at: Vec<u32>,
     /// Unchanged triangles that may fill the holes.
     candidates: Vec<u32>,
+    /// The new shading of re-shaded triangles' pieces (from `first_piece`), made while shading.
+    reshading: Vec<PieceShading>,
     number: u32,
     /// The view id and trial serial whose render the buffers hold.
     owner: Option<(u64, u32)>,
@@ -275,7 +274,6 @@ impl Default for Scratch {
     fn default() -> Self {
         Scratch {
             pieces: Vec::new(),
-            changed_pieces: 0,
             bbox: Vec::new(),
             rect: None,
             setup: SetupOut::default(),
@@ -287,6 +285,7 @@ impl Default for Scratch {
             visited: Vec::new(),
             reshade_at: Vec::new(),
             candidates: Vec::new(),
+            reshading: Vec::new(),
             number: 0,
             owner: None,
         }
@@ -802,6 +801,7 @@ impl View {
         let number = scratch.next_number(mesh.triangle_slots().max(self.pieces.len()));
         let reshade = number | RESHADE;
         scratch.pieces.clear();
+        scratch.reshading.clear();
         scratch.bbox.clear();
         scratch.rect = None;
         // The pixels that can change: those showing a changed or re-shaded triangle now (its
@@ -815,6 +815,8 @@ impl View {
             {
                 rect = Some(union(rect, *b));
                 shows_now = true;
+                // Its pixels are read first thing in the render: ask now, while set-up runs.
+                prefetch_rect(&self.px, shared.width as usize, *b);
             }
             let mut bb: Option<[i32; 4]> = None;
             if mesh.is_alive(t) {
@@ -837,7 +839,6 @@ impl View {
             }
             scratch.bbox.push((t, bb));
         }
-        scratch.changed_pieces = scratch.pieces.len();
         // Triangles that only need shading anew (their wedges changed, not their corners).
         for &t in &tr.reshaded {
             let tu = t as usize;
@@ -891,7 +892,7 @@ impl View {
             visited,
             reshade_at,
             candidates,
-            changed_pieces,
+            reshading,
             ..
         } = scratch;
         // Start from the committed depth and winners; where a changed triangle won, a hole opens
@@ -948,7 +949,7 @@ impl View {
             }
         }
         // The changed triangles' new pieces.
-        for (k, (t, p)) in new_pieces[..*changed_pieces].iter().enumerate() {
+        for (k, (t, p)) in new_pieces.iter().enumerate() {
             let id = (t << PIECE_BITS) | (k as u32 - first_piece[*t as usize]);
             edge::rasterize(&p.st, id, &offsets, rect, samples, &mut sample_scratch);
         }
@@ -974,28 +975,29 @@ impl View {
                         old.current
                     } else {
                         let (piece, tu) = ((id & PIECE_MASK) as usize, t as usize);
-                        let p = if s == number {
-                            &mut new_pieces[first_piece[tu] as usize + piece].1
+                        let (st, corners, shading) = if s == number {
+                            let p = &mut new_pieces[first_piece[tu] as usize + piece].1;
+                            (&p.st, &p.corners, &mut p.shading)
                         } else if s == reshade {
                             // Its geometry as committed, its shading anew.
                             if reshade_at[tu] != number {
                                 reshade_at[tu] = number;
-                                first_piece[tu] = new_pieces.len() as u32;
-                                for p in &self.pieces[tu] {
-                                    let shading = PieceShading::Unknown;
-                                    new_pieces.push((t, Piece { shading, ..*p }));
-                                }
+                                first_piece[tu] = reshading.len() as u32;
+                                let n = self.pieces[tu].len();
+                                reshading.extend((0..n).map(|_| PieceShading::Unknown));
                             }
-                            &mut new_pieces[first_piece[tu] as usize + piece].1
+                            let p = &self.pieces[tu][piece];
+                            let shading = &mut reshading[first_piece[tu] as usize + piece];
+                            (&p.st, &p.corners, shading)
                         } else {
-                            &mut self.pieces[tu][piece]
+                            let p = &mut self.pieces[tu][piece];
+                            (&p.st, &p.corners, &mut p.shading)
                         };
-                        if let PieceShading::Unknown = p.shading {
-                            p.shading =
-                                shared.piece_shading(mesh, &self.light, t, &p.st, &p.corners);
+                        if let PieceShading::Unknown = shading {
+                            *shading = shared.piece_shading(mesh, &self.light, t, st, corners);
                         }
-                        let x = x as f64 + 0.5;
-                        shade(shared, mesh, &self.light, t, p, x, y as f64 + 0.5)
+                        let (x, y) = (x as f64 + 0.5, y as f64 + 0.5);
+                        shade(shared, mesh, &self.light, t, st, corners, shading, x, y)
                     }
                 };
                 delta += sq(old.target, luma) - sq(old.target, old.current);
@@ -1022,7 +1024,7 @@ impl View {
                 self.bbox.resize(t_us + 1, None);
             }
             self.pieces[t_us].clear();
-            while k < scratch.changed_pieces && scratch.pieces[k].0 == t {
+            while k < scratch.pieces.len() && scratch.pieces[k].0 == t {
                 self.pieces[t_us].push(scratch.pieces[k].1);
                 k += 1;
             }
@@ -1122,14 +1124,16 @@ fn shade(
     mesh: &Adjacency,
     light: &[(Vec3, Vec3)],
     t: u32,
-    p: &Piece,
+    st: &SetupTri,
+    corners: &super::setup::Corners,
+    shading: &PieceShading,
     x: f64,
     y: f64,
 ) -> u16 {
-    if let PieceShading::Plane(plane) = &p.shading {
+    if let PieceShading::Plane(plane) = shading {
         return shared.encode[index_of_linear(plane.at(x - 0.5, y - 0.5))];
     }
-    let b = source_barycentrics(&p.st, &p.corners, x, y);
+    let b = source_barycentrics(st, corners, x, y);
     let c = mesh.corners(t).map(|w| w as usize);
     let wd = c.map(|w| &mesh.wedges[w]);
     let m = &shared.materials[mesh.material(t) as usize];
@@ -1140,8 +1144,8 @@ fn shade(
     if let (Some(tex), true) = (&m.texture, mesh.has_uvs()) {
         let uv_at = |bb: Vec3| -> Vec2 { wd[0].uv * bb.x + wd[1].uv * bb.y + wd[2].uv * bb.z };
         let uv = uv_at(b);
-        let dx = uv_at(source_barycentrics(&p.st, &p.corners, x + 1.0, y)) - uv;
-        let dy = uv_at(source_barycentrics(&p.st, &p.corners, x, y + 1.0)) - uv;
+        let dx = uv_at(source_barycentrics(st, corners, x + 1.0, y)) - uv;
+        let dy = uv_at(source_barycentrics(st, corners, x, y + 1.0)) - uv;
         albedo *= tex.sample(uv, dx, dy);
     }
     let d = light[c[0]].0 * b.x + light[c[1]].0 * b.y + light[c[2]].0 * b.z;
