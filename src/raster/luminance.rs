@@ -903,20 +903,26 @@ impl View {
         let w = shared.width as usize;
         prefetch_rect(&self.px, w, rect);
         let mut holes: Option<[i32; 4]> = None;
+        let rw = (x1 - x0) as usize;
         for y in y0..y1 {
-            let row = (y - y0) as usize * (x1 - x0) as usize;
-            for x in x0..x1 {
-                let i = y as usize * w + x as usize;
-                let Pixel { shown, depth, .. } = self.px[i];
-                let k = row + (x - x0) as usize;
-                if shown != EMPTY && stamp[(shown >> PIECE_BITS) as usize] == number {
-                    holes = Some(union(holes, [x, y, x + 1, y + 1]));
-                    samples.depth[k] = f32::INFINITY;
-                    samples.ids[k] = EMPTY;
-                } else {
-                    samples.depth[k] = depth;
-                    samples.ids[k] = shown;
+            let src = &self.px[y as usize * w + x0 as usize..][..rw];
+            let row = (y - y0) as usize * rw;
+            let depth_out = &mut samples.depth[row..row + rw];
+            let ids_out = &mut samples.ids[row..row + rw];
+            let (mut first, mut last) = (usize::MAX, 0);
+            for (j, p) in src.iter().enumerate() {
+                // The background's id is past every triangle's stamp.
+                let hole = stamp.get((p.shown >> PIECE_BITS) as usize) == Some(&number);
+                depth_out[j] = if hole { f32::INFINITY } else { p.depth };
+                ids_out[j] = if hole { EMPTY } else { p.shown };
+                if hole {
+                    first = first.min(j);
+                    last = j;
                 }
+            }
+            if first != usize::MAX {
+                let (a, b) = (x0 + first as i32, x0 + last as i32 + 1);
+                holes = Some(union(holes, [a, y, b, y + 1]));
             }
         }
         let offsets = [[fixed::ONE_PIXEL / 2, fixed::ONE_PIXEL / 2]];
@@ -961,11 +967,13 @@ impl View {
         new_shown.resize(n_rect, 0);
         let mut delta = 0i64;
         for y in y0..y1 {
-            for x in x0..x1 {
-                let k = ((y - y0) * (x1 - x0) + (x - x0)) as usize;
-                let i = y as usize * w + x as usize;
-                let id = samples.ids[k];
-                let old = self.px[i];
+            let row = (y - y0) as usize * rw;
+            let olds = &self.px[y as usize * w + x0 as usize..][..rw];
+            let ids = &samples.ids[row..row + rw];
+            let out = pixels[row..row + rw].iter_mut();
+            let out_shown = new_shown[row..row + rw].iter_mut();
+            let each = ids.iter().zip(olds).zip(out.zip(out_shown));
+            for (x, ((&id, &old), (out, out_shown))) in (x0..x1).zip(each) {
                 let luma = if id == EMPTY {
                     shared.background
                 } else {
@@ -1001,8 +1009,8 @@ impl View {
                     }
                 };
                 delta += sq(old.target, luma) - sq(old.target, old.current);
-                pixels[k] = luma;
-                new_shown[k] = id;
+                *out = luma;
+                *out_shown = id;
             }
         }
         delta
