@@ -1005,7 +1005,12 @@ impl View {
                             *shading = shared.piece_shading(mesh, &self.light, t, st, corners);
                         }
                         let (x, y) = (x as f64 + 0.5, y as f64 + 0.5);
-                        shade(shared, mesh, &self.light, t, st, corners, shading, x, y)
+                        let piece = ShadedPiece {
+                            st,
+                            corners,
+                            shading,
+                        };
+                        shade(shared, mesh, &self.light, t, piece, x, y)
                     }
                 };
                 delta += sq(old.target, luma) - sq(old.target, old.current);
@@ -1126,15 +1131,25 @@ impl View {
     }
 }
 
-/// Gouraud shading of source triangle `t` (set-up piece `p`) at screen point (x, y), as luminance.
+/// A piece's geometry and the shading to use for it (a re-shaded triangle's comes from the
+/// trial, not from the piece).
+struct ShadedPiece<'a> {
+    st: &'a SetupTri,
+    corners: &'a super::setup::Corners,
+    shading: &'a PieceShading,
+}
+
+/// Gouraud shading of source triangle `t` (one of its pieces) at screen point (x, y), as luminance.
 fn shade(
     shared: &Shared,
     mesh: &Adjacency,
     light: &[(Vec3, Vec3)],
     t: u32,
-    st: &SetupTri,
-    corners: &super::setup::Corners,
-    shading: &PieceShading,
+    ShadedPiece {
+        st,
+        corners,
+        shading,
+    }: ShadedPiece,
     x: f64,
     y: f64,
 ) -> u16 {
