@@ -10,6 +10,11 @@
 //! eq. 2's energy change ΔE = Σ_h Σ_{R_h} [(ŷ − y′)² − (ŷ − y)²]. `commit` makes the trial the
 //! current state; `revert` drops it. Views are independent and run in parallel.
 //!
+//! R_h is only what can change: the old box of a changed triangle that shows in no pixel, and a
+//! new piece behind every committed depth of the tiles it touches (while nothing that changed
+//! shows), are left out, so a move on the far side of the mesh often renders nothing in a view.
+//! Per-triangle shown-pixel counts and per-tile farthest depths, kept on commit, decide this.
+//!
 //! Decisions:
 //! - Luminance is the paper's: NTSC weights (0.299, 0.587, 0.114) on the displayed (sRGB-encoded)
 //!   values, computed here from the linear colour as Y = encode(0.299 R + 0.587 G + 0.114 B) and
@@ -19,8 +24,17 @@
 //! - One sample at the pixel centre and no anti-aliasing, like the paper's OpenGL renders; shading
 //!   is the rasterizer's `gouraud` model (vertex-lit Blinn–Phong with the scene's lights, per-wedge
 //!   normals, colours and base-colour texture), with the same set-up, edge functions, fill rule,
-//!   interpolation and texture filtering, so a full render here equals `raster::render` at one
-//!   sample per pixel converted to luminance (tested).
+//!   interpolation and texture filtering. Pieces of constant albedo (no vertex colours, no
+//!   texture) are shaded through a ratio of two screen planes ([`LumaPlane`]) in f64 rather than
+//!   the rasterizer's per-channel f32 barycentric sums, so a full render here equals
+//!   `raster::render` at one sample per pixel converted to luminance up to one 16-bit code on a
+//!   pixel in ~1 600 (tested); within the optimizer every image is shaded the same way, so energies
+//!   stay exact.
+//! - Memory is what a trial spends its time on: twenty views' images and set-ups (≈ 20 MB) are
+//!   cold by the time a view's turn comes. So a committed pixel is one 12-byte record, a
+//!   triangle's first piece is stored in place, the dirty pixels and the per-vertex and per-triangle
+//!   entries a trial gathers are prefetched, and the trial's working buffers (new pieces, samples,
+//!   stamps) are per thread, not per view (`commit` renders again if they have moved on).
 //! - Tiles of [`BUCKET`] pixels rather than the paper's per-row/per-column hash tables: one lookup
 //!   per tile of R_h instead of an intersection of two unions, and the lists change only where a
 //!   triangle's box crosses a tile boundary.
