@@ -25,7 +25,7 @@
 //!   is the rasterizer's `gouraud` model (vertex-lit Blinn–Phong with the scene's lights, per-wedge
 //!   normals, colours and base-colour texture), with the same set-up, edge functions, fill rule,
 //!   interpolation and texture filtering. Pieces of constant albedo (no vertex colours, no
-//!   texture) are shaded through a ratio of two screen planes ([`LumaPlane`]) in f64 rather than
+//!   texture) are shaded through a ratio of two screen planes (`LumaPlane`) in f64 rather than
 //!   the rasterizer's per-channel f32 barycentric sums, so a full render here equals
 //!   `raster::render` at one sample per pixel converted to luminance up to one 16-bit code on a
 //!   pixel in ~1 600 (tested); within the optimizer every image is shaded the same way, so energies
