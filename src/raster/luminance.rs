@@ -74,8 +74,8 @@ struct Piece {
     shading: PieceShading,
 }
 
-/// How a piece's pixels are shaded, worked out the first time one is (a third of a view's pieces
-/// face away and are never shaded).
+/// How a piece's pixels are shaded, worked out the first time one is (many of a view's pieces
+/// face away or are hidden and are never shaded).
 #[derive(Debug, Clone, Copy)]
 enum PieceShading {
     /// Not yet known (new piece, or its wedges' light terms changed).
@@ -216,8 +216,7 @@ impl BucketEntry {
     /// Whether its box overlaps rectangle `r`.
     #[inline]
     fn overlaps(&self, r: [i32; 4]) -> bool {
-        let b = self.bbox.map(i32::from);
-        b[0] < r[2] && r[0] < b[2] && b[1] < r[3] && r[1] < b[3]
+        overlap(self.bbox.map(i32::from), r)
     }
 }
 
@@ -273,7 +272,7 @@ struct Scratch {
     first_piece: Vec<u32>,
     /// Per source triangle: the render number that already rasterized it.
     visited: Vec<u32>,
-    /// Per source triangle: the render number that copied its pieces for re-shading.
+    /// Per source triangle: the render number that gave it new entries in `reshading`.
     reshade_at: Vec<u32>,
     /// Unchanged triangles that may fill the holes.
     candidates: Vec<u32>,
@@ -673,6 +672,12 @@ fn prefetch_rect<T>(px: &[T], w: usize, [x0, y0, x1, y1]: [i32; 4]) {
     }
 }
 
+/// Whether pixel rectangles `a` and `b` (`[x0, y0, x1, y1)`) share a pixel.
+#[inline]
+fn overlap(a: [i32; 4], b: [i32; 4]) -> bool {
+    a[0] < b[2] && b[0] < a[2] && a[1] < b[3] && b[1] < a[3]
+}
+
 /// Whether triangle `t` shows in any committed pixel, by the view's per-triangle counts.
 #[inline]
 fn shows(shown_count: &[u32], t: u32) -> bool {
@@ -943,7 +948,6 @@ impl View {
         let mut sample_scratch = [[0i64; 3]; 1];
         if let Some(h) = holes {
             // The unchanged triangles overlapping the holes (through the buckets), each once.
-            let overlaps = |b: [i32; 4]| b[0] < h[2] && h[0] < b[2] && b[1] < h[3] && h[1] < b[3];
             // Gathered first and their pieces prefetched, so the misses overlap.
             candidates.clear();
             for tile in tiles(self.tiles_x, h) {
@@ -961,7 +965,7 @@ impl View {
             }
             for &t in candidates.iter() {
                 for (k, p) in self.pieces[t as usize].iter().enumerate() {
-                    if overlaps(p.st.bbox()) {
+                    if overlap(p.st.bbox(), h) {
                         let id = (t << PIECE_BITS) | k as u32;
                         edge::rasterize(&p.st, id, &offsets, h, samples, &mut sample_scratch);
                     }
