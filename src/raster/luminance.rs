@@ -242,10 +242,6 @@ struct Trial {
     serial: u32,
     saved_xf: Vec<(u32, XfVertex)>,
     saved_light: Vec<(u32, (Vec3, Vec3))>,
-    /// The changed triangles (see [`Change::triangles`]).
-    triangles: Vec<u32>,
-    /// The re-shaded triangles (see [`Change::reshaded`]).
-    reshaded: Vec<u32>,
     /// Whether the whole image is rendered (the first render).
     everything: bool,
 }
@@ -341,6 +337,9 @@ pub struct LumaViews {
     /// Material of each wedge (for its light terms): that of the first triangle using it.
     wedge_material: Vec<u32>,
     pending: bool,
+    /// The pending trial's changed and re-shaded triangles (for a commit; the same in every view).
+    pending_triangles: Vec<u32>,
+    pending_reshaded: Vec<u32>,
 }
 
 /// sRGB encoding of a linear value in [0, 1].
@@ -516,7 +515,7 @@ impl LumaViews {
         views.par_iter_mut().for_each(|v| {
             with_scratch(|s| {
                 v.trial(shared_ref, mesh, wm, &change, true, s);
-                v.commit(shared_ref, mesh, s);
+                v.commit(shared_ref, mesh, &change, s);
             });
             if compare_with_self {
                 v.px.iter_mut().for_each(|p| p.target = p.current);
@@ -527,6 +526,8 @@ impl LumaViews {
             views,
             wedge_material,
             pending: false,
+            pending_triangles: Vec::new(),
+            pending_reshaded: Vec::new(),
         })
     }
 
@@ -597,6 +598,10 @@ impl LumaViews {
             }
         }
         self.pending = true;
+        self.pending_triangles.clear();
+        self.pending_triangles.extend_from_slice(change.triangles);
+        self.pending_reshaded.clear();
+        self.pending_reshaded.extend_from_slice(change.reshaded);
         let shared = &self.shared;
         let wm = &self.wedge_material;
         self.views
@@ -611,9 +616,15 @@ impl LumaViews {
             return;
         }
         let shared = &self.shared;
+        let change = Change {
+            vertices: &[],
+            wedges: &[],
+            triangles: &self.pending_triangles,
+            reshaded: &self.pending_reshaded,
+        };
         self.views
             .par_iter_mut()
-            .for_each(|v| with_scratch(|s| v.commit(shared, mesh, s)));
+            .for_each(|v| with_scratch(|s| v.commit(shared, mesh, &change, s)));
     }
 
     /// Drop the pending trial.
@@ -656,19 +667,15 @@ fn prefetch<T>(x: *const T) {
 /// view's images are cold when its turn comes, and rows fetched one miss at a time were most of
 /// a trial's time.
 fn prefetch_rect<T>(px: &[T], w: usize, [x0, y0, x1, y1]: [i32; 4]) {
-    {
-        let line = 64 / std::mem::size_of::<T>().max(1);
-        for y in y0..y1 {
-            let row = y as usize * w;
-            let (a, b) = (row + x0 as usize, row + x1 as usize);
-            let mut i = a;
-            while i < b {
-                prefetch(&px[i]);
-                i += line;
-            }
-            // The row's last line, when the stride skipped it.
-            prefetch(&px[b - 1]);
+    let line = 64 / std::mem::size_of::<T>().max(1);
+    for y in y0..y1 {
+        let row = y as usize * w;
+        let (a, b) = (row + x0 as usize, row + x1 as usize);
+        for i in (a..b).step_by(line) {
+            prefetch(&px[i]);
         }
+        // The row's last line, when the stride skipped it.
+        prefetch(&px[b - 1]);
     }
 }
 
@@ -740,10 +747,6 @@ impl View {
         tr.serial = tr.serial.wrapping_add(1);
         tr.saved_xf.clear();
         tr.saved_light.clear();
-        tr.triangles.clear();
-        tr.triangles.extend_from_slice(change.triangles);
-        tr.reshaded.clear();
-        tr.reshaded.extend_from_slice(change.reshaded);
         tr.everything = everything;
         // Everything below gathers from this view's cold per-vertex, per-wedge and per-triangle
         // arrays: ask for all of it first.
@@ -798,14 +801,20 @@ impl View {
                 );
             }
         }
-        self.build(shared, mesh, scratch)
+        self.build(shared, mesh, change, scratch)
     }
 
     /// Set up the pending trial's changed triangles and render its rectangle into `scratch`;
     /// return ΔE. A function of the view's state alone, so [`View::commit`] can run it again
     /// when `scratch` has since served another view.
-    fn build(&mut self, shared: &Shared, mesh: &Adjacency, scratch: &mut Scratch) -> i64 {
-        let delta = if self.prepare(shared, mesh, scratch) {
+    fn build(
+        &mut self,
+        shared: &Shared,
+        mesh: &Adjacency,
+        change: &Change,
+        scratch: &mut Scratch,
+    ) -> i64 {
+        let delta = if self.prepare(shared, mesh, change, scratch) {
             self.render(shared, mesh, scratch)
         } else {
             0
@@ -815,7 +824,13 @@ impl View {
     }
 
     /// New set-up of the changed triangles and the dirty rectangle; false if it is empty.
-    fn prepare(&self, shared: &Shared, mesh: &Adjacency, scratch: &mut Scratch) -> bool {
+    fn prepare(
+        &self,
+        shared: &Shared,
+        mesh: &Adjacency,
+        change: &Change,
+        scratch: &mut Scratch,
+    ) -> bool {
         let tr = &self.trial;
         let number = scratch.next_number(mesh.triangle_slots().max(self.pieces.len()));
         let reshade = number | RESHADE;
@@ -827,7 +842,7 @@ impl View {
         // old box, when it shows at all) and those a new piece covers.
         let mut rect: Option<[i32; 4]> = None;
         let mut shows_now = false;
-        for &t in &tr.triangles {
+        for &t in change.triangles {
             scratch.stamp[t as usize] = number;
             if let Some(Some(b)) = self.bbox.get(t as usize)
                 && shows(&self.shown_count, t)
@@ -859,7 +874,7 @@ impl View {
             scratch.bbox.push((t, bb));
         }
         // Triangles that only need shading anew (their wedges changed, not their corners).
-        for &t in &tr.reshaded {
+        for &t in change.reshaded {
             let tu = t as usize;
             if scratch.stamp[tu] != number && scratch.stamp[tu] != reshade {
                 scratch.stamp[tu] = reshade;
@@ -1041,9 +1056,15 @@ impl View {
 
     /// Make the pending trial the committed state (rendering it again if `scratch` no longer
     /// holds it).
-    fn commit(&mut self, shared: &Shared, mesh: &Adjacency, scratch: &mut Scratch) {
+    fn commit(
+        &mut self,
+        shared: &Shared,
+        mesh: &Adjacency,
+        change: &Change,
+        scratch: &mut Scratch,
+    ) {
         if scratch.owner != Some((self.id, self.trial.serial)) {
-            self.build(shared, mesh, scratch);
+            self.build(shared, mesh, change, scratch);
         }
         let tr = &mut self.trial;
         // Pieces and buckets of the changed triangles.
@@ -1077,7 +1098,7 @@ impl View {
                 self.bbox[t_us] = bb;
             }
         }
-        for &t in &tr.reshaded {
+        for &t in change.reshaded {
             for p in self.pieces.get_mut(t as usize).into_iter().flatten() {
                 p.shading = PieceShading::Unknown;
             }
@@ -1128,8 +1149,6 @@ impl View {
         }
         tr.saved_xf.clear();
         tr.saved_light.clear();
-        tr.triangles.clear();
-        tr.reshaded.clear();
         // What the scratch holds is committed now, not a pending trial.
         scratch.owner = None;
     }
@@ -1144,8 +1163,6 @@ impl View {
         }
         tr.saved_xf.clear();
         tr.saved_light.clear();
-        tr.triangles.clear();
-        tr.reshaded.clear();
     }
 }
 
