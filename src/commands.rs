@@ -848,7 +848,7 @@ pub fn bench_simplify(
     for (name, mesh) in meshes {
         let original = crate::mesh::surface_distance::Original::new(mesh, samples);
         for &ratio in ratios {
-            for method in [Method::Meshopt, Method::Qem] {
+            for method in [Method::Meshopt, Method::MeshoptUpdate, Method::Qem] {
                 let start = std::time::Instant::now();
                 let lod = crate::simplify::chain(mesh, method, &[Goal::Ratio(ratio)])?
                     .pop()

@@ -331,8 +331,9 @@ struct SimplifyArgs {
     /// Run Williams et al. 2003's evaluation from a config (configs/papers/williams2003.toml).
     #[arg(long, conflicts_with_all = ["mesh", "out"])]
     experiment: Option<PathBuf>,
-    /// qem (our edge collapse, Garland–Heckbert quadrics), cluster (Rossignac–Borrel), meshopt, or
-    /// williams (Williams et al. 2003: perceptual, view-dependent, to a --budget).
+    /// qem (our edge collapse, Garland–Heckbert quadrics), cluster (Rossignac–Borrel), meshopt,
+    /// meshopt-update (meshoptimizer moving vertices and attributes, as qem does), or williams
+    /// (Williams et al. 2003: perceptual, view-dependent, to a --budget).
     #[arg(long, default_value = "qem")]
     method: String,
     /// williams: triangle budget.
@@ -840,9 +841,10 @@ fn run(cli: Cli) -> Result<(), Error> {
                 "qem" => Method::Qem,
                 "cluster" => Method::Cluster,
                 "meshopt" => Method::Meshopt,
+                "meshopt-update" => Method::MeshoptUpdate,
                 m => {
                     return Err(Error::Usage(format!(
-                        "--method {m}: use qem, cluster, meshopt or williams"
+                        "--method {m}: use qem, cluster, meshopt, meshopt-update or williams"
                     )));
                 }
             };

@@ -406,8 +406,9 @@ pub struct LodConfig {
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct GenerateConfig {
-    /// `meshopt` (meshoptimizer's `simplify`, the industrial baseline), `qem` (our edge collapse
-    /// with Garland–Heckbert quadrics) or `cluster` (Rossignac–Borrel vertex clustering).
+    /// `meshopt` (meshoptimizer's `simplify`, the industrial baseline), `meshopt-update`
+    /// (meshoptimizer's `simplifyWithUpdate`, moving vertices and attributes), `qem` (our edge
+    /// collapse with Garland–Heckbert quadrics) or `cluster` (Rossignac–Borrel vertex clustering).
     pub method: crate::simplify::Method,
     /// Target triangle ratios of the original, each LOD simplified from the previous one.
     #[serde(default)]

@@ -1,9 +1,13 @@
-//! The industrial baseline: meshoptimizer's `meshopt_simplify` (through the `meshopt` crate), as
-//! engines use it to build LOD chains.
+//! The industrial baseline: meshoptimizer (through the `meshopt` crate), as engines use it to
+//! build LOD chains. Two modes: `meshopt_simplify` (method `meshopt`) and
+//! `meshopt_simplifyWithUpdate` (method `meshopt-update`), meshoptimizer's attribute-aware mode
+//! that also moves the vertices it keeps, which is what our QEM does.
 //!
 //! Decisions:
-//! - Only the index buffer changes; the LOD keeps the original vertices and their normals, as an
-//!   engine's LOD built this way shares the vertex buffer. Unused vertices are dropped afterwards.
+//! - `meshopt`: only the index buffer changes; the LOD keeps the original vertices and their
+//!   normals, as an engine's LOD built this way shares the vertex buffer. `meshopt-update`: the kept
+//!   vertices get meshoptimizer's new positions and attributes (normals renormalized). Unused
+//!   vertices are dropped afterwards.
 //! - Multi-material meshes are simplified one material at a time, with the vertices that several
 //!   materials share locked, so material borders cannot open cracks. The triangle target is
 //!   shared out in proportion to each material's triangles.
@@ -14,7 +18,9 @@
 //!   to under-state the true maximum deviation; lodeval's Hausdorff distance is the honest one.
 
 use crate::error::Result;
-use crate::mesh::{LoadOptions, Mesh};
+use glam::{Vec2, Vec3};
+
+use crate::mesh::{LoadOptions, Mesh, MeshData};
 
 /// What to aim for.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -36,16 +42,128 @@ pub struct Simplified {
     pub absolute_error: f32,
 }
 
-/// Simplify `mesh` towards `target`.
+/// Simplify `mesh` towards `target` (`meshopt_simplify`: the index buffer changes, the vertices
+/// stay).
 pub fn simplify(mesh: &Mesh, target: Target) -> Result<Simplified> {
     let positions: Vec<[f32; 3]> = mesh.positions().iter().map(|p| p.to_array()).collect();
-    let tris = mesh.triangles().to_vec();
-    let (out_tris, out_mats, worst_error) = by_material(mesh, &positions, &tris, target);
+    let (tris, mats, worst_error) = by_material(mesh, target, |indices, locked, count, error| {
+        let mut e = 0f32;
+        let r = ::meshopt::simplify_with_locks_decoder(
+            indices,
+            &positions,
+            locked,
+            count,
+            error,
+            ::meshopt::SimplifyOptions::None,
+            Some(&mut e),
+        );
+        (r, e)
+    });
     let mut data = mesh.to_data();
     data.normals = Some(mesh.normals().to_vec());
-    data.triangles = out_tris;
-    data.material_ids = out_mats;
-    let scale = ::meshopt::simplify_scale_decoder(&positions);
+    finish(data, tris, mats, worst_error, &positions)
+}
+
+/// Simplify `mesh` towards `target` with `meshopt_simplifyWithUpdate`: meshoptimizer's own
+/// attribute-aware mode, which also moves the kept vertices and updates their attributes (its
+/// counterpart of our QEM's optimal placement and attribute quadrics, so the like-for-like peer).
+/// The attributes are the normals, and the UVs and colours where the mesh has them, weighted in
+/// the units `attributes.rs` states for our QEM: meshoptimizer measures positions in units of
+/// the mesh extent, so each weight is our scale × diagonal / extent.
+pub fn simplify_updating(mesh: &Mesh, target: Target) -> Result<Simplified> {
+    use super::attributes::{COLOR_SCALE, NORMAL_SCALE, UV_SCALE};
+    let mut positions: Vec<[f32; 3]> = mesh.positions().iter().map(|p| p.to_array()).collect();
+    let extent = ::meshopt::simplify_scale_decoder(&positions);
+    let unit = mesh.aabb().diagonal() / extent.max(f32::MIN_POSITIVE);
+    let (uvs, colors) = (mesh.uvs(), mesh.colors());
+    let mut weights = vec![NORMAL_SCALE as f32 * unit; 3];
+    if uvs.is_some() {
+        weights.extend([UV_SCALE as f32 * unit; 2]);
+    }
+    if colors.is_some() {
+        weights.extend([COLOR_SCALE as f32 * unit; 3]);
+    }
+    let k = weights.len();
+    let mut attributes = Vec::with_capacity(k * positions.len());
+    for v in 0..positions.len() {
+        attributes.extend(mesh.normals()[v].to_array());
+        if let Some(uv) = uvs {
+            attributes.extend(uv[v].to_array());
+        }
+        if let Some(c) = colors {
+            attributes.extend(c[v].to_array());
+        }
+    }
+    let (tris, mats, worst_error) = by_material(mesh, target, |indices, locked, count, error| {
+        let lock: Vec<::meshopt::SimplifyVertex> = locked
+            .iter()
+            .map(|&l| {
+                if l {
+                    ::meshopt::SimplifyVertex::Lock
+                } else {
+                    ::meshopt::SimplifyVertex::None
+                }
+            })
+            .collect();
+        let mut r = indices.to_vec();
+        let mut e = 0f32;
+        let n = ::meshopt::simplify_with_update(
+            &mut r,
+            &mut positions,
+            &mut attributes,
+            &weights,
+            k * std::mem::size_of::<f32>(),
+            Some(&lock),
+            count,
+            error,
+            ::meshopt::SimplifyOptions::None,
+            Some(&mut e),
+        );
+        r.truncate(n);
+        (r, e)
+    });
+    let mut data = mesh.to_data();
+    data.positions = positions.iter().map(|&p| Vec3::from_array(p)).collect();
+    let at = |v: usize, i: usize| attributes[v * k + i];
+    let original = mesh.normals();
+    data.normals = Some(
+        (0..positions.len())
+            .map(|v| {
+                Vec3::new(at(v, 0), at(v, 1), at(v, 2))
+                    .try_normalize()
+                    .unwrap_or(original[v])
+            })
+            .collect(),
+    );
+    if uvs.is_some() {
+        data.uvs = Some(
+            (0..positions.len())
+                .map(|v| Vec2::new(at(v, 3), at(v, 4)))
+                .collect(),
+        );
+    }
+    if colors.is_some() {
+        let o = if uvs.is_some() { 5 } else { 3 };
+        data.colors = Some(
+            (0..positions.len())
+                .map(|v| Vec3::new(at(v, o), at(v, o + 1), at(v, o + 2)))
+                .collect(),
+        );
+    }
+    finish(data, tris, mats, worst_error, &positions)
+}
+
+/// The LOD from the simplified triangles, with meshoptimizer's error in both units.
+fn finish(
+    mut data: MeshData,
+    tris: Vec<[u32; 3]>,
+    mats: Vec<u32>,
+    worst_error: f32,
+    positions: &[[f32; 3]],
+) -> Result<Simplified> {
+    data.triangles = tris;
+    data.material_ids = mats;
+    let scale = ::meshopt::simplify_scale_decoder(positions);
     Ok(Simplified {
         mesh: Mesh::new(data, &LoadOptions::default())?,
         relative_error: worst_error,
@@ -53,19 +171,21 @@ pub fn simplify(mesh: &Mesh, target: Target) -> Result<Simplified> {
     })
 }
 
-/// Simplify `tris` (indices into `positions`) material by material; returns the triangles, their
-/// material ids and the largest relative error.
+/// Simplify `mesh`'s triangles material by material with `one(indices, locked, target index
+/// count, target error) -> (indices, relative error)`; returns the triangles, their material ids
+/// and the largest relative error.
 fn by_material(
     mesh: &Mesh,
-    positions: &[[f32; 3]],
-    tris: &[[u32; 3]],
     target: Target,
+    mut one: impl FnMut(&[u32], &[bool], usize, f32) -> (Vec<u32>, f32),
 ) -> (Vec<[u32; 3]>, Vec<u32>, f32) {
+    let tris = mesh.triangles();
     let mats = mesh.material_ids();
     let material_count = mesh.materials().len();
+    let vertex_count = mesh.vertex_count();
     // Vertices used by more than one material are locked.
-    let mut first_material = vec![u32::MAX; positions.len()];
-    let mut locked = vec![false; positions.len()];
+    let mut first_material = vec![u32::MAX; vertex_count];
+    let mut locked = vec![false; vertex_count];
     for (t, &m) in tris.iter().zip(mats) {
         for &v in t {
             let f = &mut first_material[v as usize];
@@ -96,16 +216,7 @@ fn by_material(
             }
             Target::Error(e) => (0, e),
         };
-        let mut error = 0f32;
-        let result = ::meshopt::simplify_with_locks_decoder(
-            &indices,
-            positions,
-            &locked,
-            target_count,
-            target_error,
-            ::meshopt::SimplifyOptions::None,
-            Some(&mut error),
-        );
+        let (result, error) = one(&indices, &locked, target_count, target_error);
         worst_error = worst_error.max(error);
         for t in result.chunks_exact(3) {
             out_tris.push([t[0], t[1], t[2]]);
@@ -127,16 +238,59 @@ mod tests {
         let m = s.mesh.triangle_count();
         assert!(m <= n / 2 && m > n / 3, "{n} -> {m}");
         assert!(s.relative_error > 0.0 && s.absolute_error > 0.0);
-        // Closed: every welded edge has exactly two triangles.
+        assert_closed(&s.mesh);
+    }
+
+    /// Closed: every welded edge has exactly two triangles.
+    fn assert_closed(mesh: &Mesh) {
         let mut edges = std::collections::BTreeMap::new();
-        let w = s.mesh.weld();
-        for t in s.mesh.triangles() {
+        let w = mesh.weld();
+        for t in mesh.triangles() {
             for k in 0..3 {
                 let (a, b) = (w[t[k] as usize], w[t[(k + 1) % 3] as usize]);
                 *edges.entry((a.min(b), a.max(b))).or_insert(0) += 1;
             }
         }
         assert!(edges.values().all(|&c| c == 2));
+    }
+
+    #[test]
+    fn the_update_mode_moves_vertices_and_keeps_the_sphere_closed() {
+        // simplifyWithUpdate places the kept vertices anew: some of them are off the original's
+        // vertex positions (the index-only mode keeps every one of them), the result stays a
+        // closed surface at half the triangles, and its normals are unit length.
+        let sphere = crate::mesh::shapes::icosphere(4);
+        let n = sphere.triangle_count();
+        let s = simplify_updating(&sphere, Target::Triangles(n / 2)).unwrap();
+        let m = s.mesh.triangle_count();
+        assert!(m <= n / 2 && m > n / 3, "{n} -> {m}");
+        let original: std::collections::HashSet<[u32; 3]> = sphere
+            .positions()
+            .iter()
+            .map(|p| p.to_array().map(f32::to_bits))
+            .collect();
+        let moved = s
+            .mesh
+            .positions()
+            .iter()
+            .filter(|p| !original.contains(&p.to_array().map(f32::to_bits)))
+            .count();
+        assert!(moved > 0, "no vertex moved");
+        let indexed = simplify(&sphere, Target::Triangles(n / 2)).unwrap();
+        assert!(
+            indexed
+                .mesh
+                .positions()
+                .iter()
+                .all(|p| original.contains(&p.to_array().map(f32::to_bits)))
+        );
+        assert!(
+            s.mesh
+                .normals()
+                .iter()
+                .all(|v| (v.length() - 1.0).abs() < 1e-5)
+        );
+        assert_closed(&s.mesh);
     }
 
     #[test]

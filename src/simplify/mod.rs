@@ -42,6 +42,9 @@ pub enum Method {
     Cluster,
     /// meshoptimizer's `simplify`.
     Meshopt,
+    /// meshoptimizer's `simplifyWithUpdate`: attribute-aware, moves the kept vertices.
+    #[serde(rename = "meshopt-update")]
+    MeshoptUpdate,
     /// Williams et al. 2003 perceptual budget refinement: one static LOD for the 20 views of the
     /// default rig (each node keyed by its worst view), Gouraud shading, default viewing.
     Williams,
@@ -54,6 +57,7 @@ impl Method {
             Method::Qem => "qem",
             Method::Cluster => "cluster",
             Method::Meshopt => "meshopt",
+            Method::MeshoptUpdate => "meshopt-update",
             Method::Williams => "williams",
         }
     }
@@ -180,7 +184,7 @@ fn chain_of(mesh: &Mesh, method: Method, goals: &[Goal]) -> Result<Vec<Lod>> {
         Goal::Error(_) => None,
     };
     match method {
-        Method::Meshopt => {
+        Method::Meshopt | Method::MeshoptUpdate => {
             let mut out: Vec<Lod> = Vec::new();
             for &g in goals {
                 let input = out.last().map_or(mesh, |l| &l.mesh);
@@ -191,7 +195,11 @@ fn chain_of(mesh: &Mesh, method: Method, goals: &[Goal]) -> Result<Vec<Lod>> {
                         _ => unreachable!(),
                     },
                 };
-                let s = meshopt::simplify(input, target)?;
+                let s = if method == Method::Meshopt {
+                    meshopt::simplify(input, target)?
+                } else {
+                    meshopt::simplify_updating(input, target)?
+                };
                 let acc = out.last().and_then(|l| l.error).unwrap_or(0.0);
                 out.push(Lod {
                     mesh: s.mesh,

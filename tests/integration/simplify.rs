@@ -7,7 +7,7 @@ use crate::common::{lodeval, model, simplify};
 fn simplify_writes_loadable_lods_with_every_method() {
     let dir = tempfile::tempdir().unwrap();
     let src = model("spot/spot_mtl.obj");
-    for method in ["qem", "cluster", "meshopt"] {
+    for method in ["qem", "cluster", "meshopt", "meshopt-update"] {
         let out = dir.path().join(format!("{method}.obj"));
         let r = simplify(
             &src,
