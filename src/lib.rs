@@ -31,6 +31,7 @@ pub mod gpu;
 pub mod io;
 pub mod mesh;
 pub mod metric;
+pub(crate) mod prefetch;
 pub mod raster;
 pub mod scene;
 pub mod simplify;

@@ -245,6 +245,11 @@ impl Adjacency {
         }
     }
 
+    /// `v`'s wedge, when it has a single one.
+    pub fn single_wedge(&self, v: u32) -> Option<u32> {
+        self.only_wedge.get(v as usize).copied().filter(|&w| w != SEVERAL)
+    }
+
     /// The wedges of `a` and `b` when each has a single one.
     fn single_wedges(&self, a: u32, b: u32) -> Option<(u32, u32)> {
         let (wa, wb) = (self.only_wedge[a as usize], self.only_wedge[b as usize]);

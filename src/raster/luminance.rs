@@ -50,6 +50,7 @@ use super::shade::{ResolvedLight, light_terms, source_barycentrics};
 use super::texture::MipTexture;
 use super::{camera_setup, fixed, rect_union as union};
 use crate::error::{Error, Result};
+use crate::prefetch::{prefetch, prefetch_at};
 use crate::mesh::adjacency::Adjacency;
 use crate::scene::{Camera, Scene};
 
@@ -640,27 +641,6 @@ impl LumaViews {
 fn sq(t: u16, y: u16) -> i64 {
     let d = t as i64 - y as i64;
     d * d
-}
-
-/// Ask for the cache line of `v[i]`, if there is one.
-#[inline]
-fn prefetch_at<T>(v: &[T], i: u32) {
-    if let Some(x) = v.get(i as usize) {
-        prefetch(x);
-    }
-}
-
-/// Ask for the cache line holding `x`.
-#[inline]
-fn prefetch<T>(x: *const T) {
-    #[cfg(target_arch = "x86_64")]
-    // SAFETY: a prefetch is a hint and never faults.
-    unsafe {
-        use std::arch::x86_64::{_MM_HINT_T0, _mm_prefetch};
-        _mm_prefetch(x as *const i8, _MM_HINT_T0)
-    };
-    #[cfg(not(target_arch = "x86_64"))]
-    let _ = x;
 }
 
 /// Ask for the cache lines of `rect`'s pixels in row-major `px` (`w` per row) at once: every

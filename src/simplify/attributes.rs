@@ -159,6 +159,17 @@ impl AttributeQuadrics {
         }
     }
 
+    /// Ask for the cache lines of wedge `w`'s quadric.
+    pub fn prefetch(&self, w: u32) {
+        let start = w as usize * self.stride;
+        if let Some(d) = self.data.get(start..start + self.stride) {
+            for i in (0..d.len()).step_by(8) {
+                crate::prefetch::prefetch(&d[i]);
+            }
+            crate::prefetch::prefetch(&d[d.len() - 1]);
+        }
+    }
+
     /// Add wedge `src`'s quadric into wedge `dst`'s.
     pub fn merge(&mut self, dst: u32, src: u32) {
         if dst == src {

@@ -127,6 +127,9 @@ impl Quadric {
 pub trait CollapseCost: Sync {
     /// Cost (lower collapses first), the new position, and the error to record (model units).
     fn evaluate(&self, adj: &Adjacency, a: u32, b: u32) -> (f64, Vec3, f64);
+    /// Vertex `v` is about to be evaluated: ask for its data's cache lines, so that the misses of
+    /// a collapse's whole ring of re-evaluated edges overlap. A hint only.
+    fn prefetch(&self, _adj: &Adjacency, _v: u32) {}
     /// The new position and the error of collapsing `a` into `b` (what [`CollapseCost::evaluate`]
     /// returns besides the cost). The engine asks for this when it applies a queued collapse;
     /// a cost whose placement is cheaper than its full cost overrides it.
@@ -254,6 +257,17 @@ impl CollapseCost for QemCost {
             });
         }
         (cost, p.as_vec3(), q.rms(p))
+    }
+
+    fn prefetch(&self, adj: &Adjacency, v: u32) {
+        let q = &self.quadrics[v as usize];
+        crate::prefetch::prefetch(q);
+        crate::prefetch::prefetch(&q.w);
+        crate::prefetch::prefetch_at(&adj.positions, v);
+        if let (Some(attrs), Some(w)) = (&self.attributes, adj.single_wedge(v)) {
+            attrs.prefetch(w);
+            crate::prefetch::prefetch_at(&adj.wedges, w);
+        }
     }
 
     fn placement(&self, adj: &Adjacency, a: u32, b: u32) -> (Vec3, f64) {
@@ -471,7 +485,11 @@ pub fn run(adj: Adjacency, cost: &mut dyn CollapseCost, stop: Stop, diagonal: f6
         });
         // Only the edges around `to` changed (its quadric and position); their old entries
         // carry `to`'s old version and are skipped when popped.
-        for n in adj.neighbours(to) {
+        let ring = adj.neighbours(to);
+        for &n in &ring {
+            cost.prefetch(&adj, n);
+        }
+        for n in ring {
             if let Some(e) = entry(&adj, cost, &version, to, n) {
                 heap.push(e);
             }
