@@ -184,20 +184,38 @@ impl AttributeQuadrics {
     /// For the summed quadric of `wedges` at position `x`: the optimal attributes (as a wedge,
     /// starting from `keep` where the system is singular) and the quadric's value there.
     pub fn optimal(&self, wedges: &[u32], x: DVec3, keep: &Wedge) -> (Wedge, f64) {
+        let mut attrs = [0.0; MAX_M];
+        let value = self.solve(wedges, x, keep, &mut attrs);
+        (self.wedge_from(&attrs, keep), value)
+    }
+
+    /// The value part of [`AttributeQuadrics::optimal`] alone (what a queued edge's cost needs).
+    pub fn cost(&self, wedges: &[u32], x: DVec3, keep: &Wedge) -> f64 {
+        self.solve(wedges, x, keep, &mut [0.0; MAX_M])
+    }
+
+    /// The optimal attributes into `attrs` and the quadric's value there.
+    fn solve(&self, wedges: &[u32], x: DVec3, keep: &Wedge, attrs: &mut [f64; MAX_M]) -> f64 {
         // One instance per dimension, so every loop below has a constant trip count (this runs
         // for every queued edge; the instances unroll).
         match self.n() {
-            6 => self.optimal_n::<6>(wedges, x, keep),
-            8 => self.optimal_n::<8>(wedges, x, keep),
-            9 => self.optimal_n::<9>(wedges, x, keep),
-            11 => self.optimal_n::<11>(wedges, x, keep),
+            6 => self.optimal_n::<6>(wedges, x, keep, attrs),
+            8 => self.optimal_n::<8>(wedges, x, keep, attrs),
+            9 => self.optimal_n::<9>(wedges, x, keep, attrs),
+            11 => self.optimal_n::<11>(wedges, x, keep, attrs),
             n => unreachable!("attribute quadrics of dimension {n}"),
         }
     }
 
     // Dense linear algebra on fixed-size arrays: index loops read like the formulas.
     #[allow(clippy::needless_range_loop)]
-    fn optimal_n<const N: usize>(&self, wedges: &[u32], x: DVec3, keep: &Wedge) -> (Wedge, f64) {
+    fn optimal_n<const N: usize>(
+        &self,
+        wedges: &[u32],
+        x: DVec3,
+        keep: &Wedge,
+        attrs: &mut [f64; MAX_M],
+    ) -> f64 {
         let (n, m) = (N, N - 3);
         let stride = n * (n + 1) / 2 + n + 1;
         debug_assert_eq!(stride, self.stride);
@@ -283,7 +301,8 @@ impl AttributeQuadrics {
             let row: f64 = (0..n).map(|j| full[i][j] * v[j]).sum();
             val += v[i] * (row + 2.0 * bv[i]);
         }
-        (self.wedge_from(&v[3..], keep), val.max(0.0))
+        attrs[..m].copy_from_slice(&v[3..]);
+        val.max(0.0)
     }
 
     fn wedge_from(&self, attrs: &[f64], keep: &Wedge) -> Wedge {

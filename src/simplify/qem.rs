@@ -253,7 +253,7 @@ impl CollapseCost for QemCost {
             && let Ok(map) = adj.edge_wedge_map(a, b)
         {
             Self::for_groups(adj, b, &map, |wb, group| {
-                cost += attrs.optimal(group, p, &adj.wedges[wb as usize]).1;
+                cost += attrs.cost(group, p, &adj.wedges[wb as usize]);
             });
         }
         (cost, p.as_vec3(), q.rms(p))
