@@ -437,7 +437,7 @@ pub fn run(adj: Adjacency, cost: &mut dyn CollapseCost, stop: Stop, diagonal: f6
         Stop::RelativeError(e) => e * diagonal,
         Stop::Triangles(_) => f64::INFINITY,
     };
-    let mut rebuild_at = 2 * heap.len().max(1024);
+    let mut rebuild_at = heap.len().max(1024) * 5 / 4;
     while let Some(e) = heap.pop() {
         if let Stop::Triangles(n) = stop
             && adj.triangle_count() <= n
@@ -449,13 +449,16 @@ pub fn run(adj: Adjacency, cost: &mut dyn CollapseCost, stop: Stop, diagonal: f6
         }
         let (a, b) = (e.a, e.b);
         // Every collapse leaves the old entries of the edges around the kept vertex behind. When
-        // the heap has doubled since it last held only current entries, at least half of it is
-        // stale: those are dropped in one linear pass (amortised O(1) per push) instead of being
-        // popped one by one from a heap grown too large for the caches. The current entries
-        // keep their order, so the collapse sequence is the same.
+        // the heap has grown by a quarter since it last held only current entries, the stale
+        // ones are dropped in one linear pass instead of being popped one by one (each pop is a
+        // walk down a heap too large for the caches). Waiting for the heap to double, as this
+        // did first, never purged at all: pops shrink the heap as fast as pushes grow it, and
+        // 90 % of pops were stale (bunny at 10 %: 266 000 of 298 000; now 37 000 of 69 000,
+        // with 14 purges). The current entries keep their order, so the collapse sequence is
+        // the same.
         if heap.len() > rebuild_at {
             heap.retain(|e| e.current(&version));
-            rebuild_at = 2 * heap.len().max(1024);
+            rebuild_at = heap.len().max(1024) * 5 / 4;
         }
         let (p, err) = cost.placement(&adj, a, b);
         if err > limit {
