@@ -251,7 +251,7 @@ impl Adjacency {
     }
 
     /// The wedges of `a` and `b` when each has a single one.
-    fn single_wedges(&self, a: u32, b: u32) -> Option<(u32, u32)> {
+    pub(crate) fn single_wedges(&self, a: u32, b: u32) -> Option<(u32, u32)> {
         let (wa, wb) = (self.only_wedge[a as usize], self.only_wedge[b as usize]);
         (wa != SEVERAL && wb != SEVERAL).then_some((wa, wb))
     }

@@ -249,9 +249,14 @@ impl CollapseCost for QemCost {
     fn evaluate(&self, adj: &Adjacency, a: u32, b: u32) -> (f64, Vec3, f64) {
         let (q, p) = self.place(adj, a, b);
         let mut cost = q.eval(p);
-        if let Some(attrs) = &self.attributes
-            && let Ok(map) = adj.edge_wedge_map(a, b)
-        {
+        let Some(attrs) = &self.attributes else {
+            return (cost, p.as_vec3(), q.rms(p));
+        };
+        if let Some((wa, wb)) = adj.single_wedges(a, b) {
+            // The common case, one wedge each: the one group `for_groups` would make, without
+            // looking at b's triangles.
+            cost += attrs.cost(&[wb, wa], p, &adj.wedges[wb as usize]);
+        } else if let Ok(map) = adj.edge_wedge_map(a, b) {
             Self::for_groups(adj, b, &map, |wb, group| {
                 cost += attrs.cost(group, p, &adj.wedges[wb as usize]);
             });
