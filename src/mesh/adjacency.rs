@@ -552,7 +552,7 @@ impl Adjacency {
     }
 
     /// Collapse `a` into `b`, moving `b` to `p`, without an undo record (for a simplifier that
-    /// never reverts). Returns the wedge map of the collapse.
+    /// never reverts). Returns the wedge map of the collapse; a refused collapse changes nothing.
     pub fn collapse_for_good(&mut self, a: u32, b: u32, p: Vec3) -> Result<WedgeMap, Reject> {
         let (shared, map) = self.check_collapse(a, b, p)?;
         self.apply_collapse(a, b, p, &shared, &map);

@@ -469,17 +469,17 @@ pub fn run(adj: Adjacency, cost: &mut dyn CollapseCost, stop: Stop, diagonal: f6
         if err > limit {
             break;
         }
-        let (from, to) = if adj.can_collapse(a, b, p).is_ok() {
-            (a, b)
-        } else if !adj.is_locked(b)
-            && adj.class(b) <= adj.class(a)
-            && adj.can_collapse(b, a, p).is_ok()
-        {
-            (b, a)
-        } else {
-            continue;
+        // A refused collapse changes nothing, so each direction is checked and applied in one go.
+        let (from, to, map) = match adj.collapse_for_good(a, b, p) {
+            Ok(map) => (a, b, map),
+            Err(_) if !adj.is_locked(b) && adj.class(b) <= adj.class(a) => {
+                match adj.collapse_for_good(b, a, p) {
+                    Ok(map) => (b, a, map),
+                    Err(_) => continue,
+                }
+            }
+            Err(_) => continue,
         };
-        let map = adj.collapse_for_good(from, to, p).expect("checked");
         let attributes = cost.collapsed(&mut adj, from, to, &map);
         version[from as usize] += 1;
         version[to as usize] += 1;
