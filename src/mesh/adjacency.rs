@@ -247,7 +247,10 @@ impl Adjacency {
 
     /// `v`'s wedge, when it has a single one.
     pub fn single_wedge(&self, v: u32) -> Option<u32> {
-        self.only_wedge.get(v as usize).copied().filter(|&w| w != SEVERAL)
+        self.only_wedge
+            .get(v as usize)
+            .copied()
+            .filter(|&w| w != SEVERAL)
     }
 
     /// The wedges of `a` and `b` when each has a single one.

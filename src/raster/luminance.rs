@@ -50,8 +50,8 @@ use super::shade::{ResolvedLight, light_terms, source_barycentrics};
 use super::texture::MipTexture;
 use super::{camera_setup, fixed, rect_union as union};
 use crate::error::{Error, Result};
-use crate::prefetch::{prefetch, prefetch_at};
 use crate::mesh::adjacency::Adjacency;
+use crate::prefetch::{prefetch, prefetch_at};
 use crate::scene::{Camera, Scene};
 
 /// Tile edge of the triangle buckets, pixels.
