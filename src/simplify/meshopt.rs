@@ -230,13 +230,19 @@ fn by_material(
 mod tests {
     use super::*;
 
-    #[test]
-    fn halves_a_sphere_and_keeps_it_closed() {
+    /// An icosphere and `f`'s LOD of it at half the triangles (checked to be about half).
+    fn halved_sphere(f: fn(&Mesh, Target) -> Result<Simplified>) -> (Mesh, Simplified) {
         let sphere = crate::mesh::shapes::icosphere(4);
         let n = sphere.triangle_count();
-        let s = simplify(&sphere, Target::Triangles(n / 2)).unwrap();
+        let s = f(&sphere, Target::Triangles(n / 2)).unwrap();
         let m = s.mesh.triangle_count();
         assert!(m <= n / 2 && m > n / 3, "{n} -> {m}");
+        (sphere, s)
+    }
+
+    #[test]
+    fn halves_a_sphere_and_keeps_it_closed() {
+        let (_, s) = halved_sphere(simplify);
         assert!(s.relative_error > 0.0 && s.absolute_error > 0.0);
         assert_closed(&s.mesh);
     }
@@ -278,11 +284,7 @@ mod tests {
         // simplifyWithUpdate places the kept vertices anew: some of them are off the original's
         // vertex positions (the index-only mode keeps every one of them), the result stays a
         // closed surface at half the triangles, and its normals are unit length.
-        let sphere = crate::mesh::shapes::icosphere(4);
-        let n = sphere.triangle_count();
-        let s = simplify_updating(&sphere, Target::Triangles(n / 2)).unwrap();
-        let m = s.mesh.triangle_count();
-        assert!(m <= n / 2 && m > n / 3, "{n} -> {m}");
+        let (sphere, s) = halved_sphere(simplify_updating);
         let original: std::collections::HashSet<[u32; 3]> = sphere
             .positions()
             .iter()
@@ -295,7 +297,7 @@ mod tests {
             .filter(|p| !original.contains(&p.to_array().map(f32::to_bits)))
             .count();
         assert!(moved > 0, "no vertex moved");
-        let indexed = simplify(&sphere, Target::Triangles(n / 2)).unwrap();
+        let (_, indexed) = halved_sphere(simplify);
         assert!(
             indexed
                 .mesh
