@@ -61,7 +61,8 @@ pub fn simplify(mesh: &Mesh, target: Target) -> Result<Simplified> {
     });
     let mut data = mesh.to_data();
     data.normals = Some(mesh.normals().to_vec());
-    finish(data, tris, mats, worst_error, &positions)
+    let extent = ::meshopt::simplify_scale_decoder(&positions);
+    finish(data, tris, mats, worst_error, extent)
 }
 
 /// Simplify `mesh` towards `target` with `meshopt_simplifyWithUpdate`: meshoptimizer's own
@@ -94,17 +95,21 @@ pub fn simplify_updating(mesh: &Mesh, target: Target) -> Result<Simplified> {
             attributes.extend(c[v].to_array());
         }
     }
+    // The locks are the same for every material: converted for the first one only.
+    let mut lock: Vec<::meshopt::SimplifyVertex> = Vec::new();
     let (tris, mats, worst_error) = by_material(mesh, target, |indices, locked, count, error| {
-        let lock: Vec<::meshopt::SimplifyVertex> = locked
-            .iter()
-            .map(|&l| {
-                if l {
-                    ::meshopt::SimplifyVertex::Lock
-                } else {
-                    ::meshopt::SimplifyVertex::None
-                }
-            })
-            .collect();
+        if lock.is_empty() {
+            lock = locked
+                .iter()
+                .map(|&l| {
+                    if l {
+                        ::meshopt::SimplifyVertex::Lock
+                    } else {
+                        ::meshopt::SimplifyVertex::None
+                    }
+                })
+                .collect();
+        }
         let mut r = indices.to_vec();
         let mut e = 0f32;
         let n = ::meshopt::simplify_with_update(
@@ -150,24 +155,25 @@ pub fn simplify_updating(mesh: &Mesh, target: Target) -> Result<Simplified> {
                 .collect(),
         );
     }
-    finish(data, tris, mats, worst_error, &positions)
+    // meshoptimizer's error is relative to the extent of the mesh it was given, before the update.
+    finish(data, tris, mats, worst_error, extent)
 }
 
-/// The LOD from the simplified triangles, with meshoptimizer's error in both units.
+/// The LOD from the simplified triangles, with meshoptimizer's error in both units (`extent`: the
+/// input's `simplify_scale`).
 fn finish(
     mut data: MeshData,
     tris: Vec<[u32; 3]>,
     mats: Vec<u32>,
     worst_error: f32,
-    positions: &[[f32; 3]],
+    extent: f32,
 ) -> Result<Simplified> {
     data.triangles = tris;
     data.material_ids = mats;
-    let scale = ::meshopt::simplify_scale_decoder(positions);
     Ok(Simplified {
         mesh: Mesh::new(data, &LoadOptions::default())?,
         relative_error: worst_error,
-        absolute_error: worst_error * scale,
+        absolute_error: worst_error * extent,
     })
 }
 
