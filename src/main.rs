@@ -177,7 +177,8 @@ struct BenchArgs {
     /// For `simplify`: also a procedural bumpy sphere of 20·4^N triangles (0: none).
     #[arg(long, default_value_t = 0)]
     bumpy: u32,
-    /// For `metrics`: timed runs per metric.
+    /// For `metrics`: timed runs per metric; for `simplify`: timed runs per method and ratio
+    /// (best and median reported).
     #[arg(long, default_value_t = 5)]
     runs: usize,
     /// Torus rings (triangles = 2 · rings · sides).
@@ -669,22 +670,24 @@ fn run(cli: Cli) -> Result<(), Error> {
                         lodeval::mesh::shapes::bumpy_sphere(a.bumpy),
                     ));
                 }
-                let rows = lodeval::commands::bench_simplify(&meshes, &a.ratios, 1_000_000)?;
+                let rows =
+                    lodeval::commands::bench_simplify(&meshes, &a.ratios, 1_000_000, a.runs)?;
                 if a.json {
                     return emit_json(&rows);
                 }
                 let mut t = String::from(
-                    "| mesh | input triangles | method | ratio | triangles | seconds | M input tri/s | Hausdorff / diagonal | mean / diagonal |\n|---|---|---|---|---|---|---|---|---|\n",
+                    "| mesh | input triangles | method | ratio | triangles | best s | median s | M input tri/s (best) | Hausdorff / diagonal | mean / diagonal |\n|---|---|---|---|---|---|---|---|---|---|\n",
                 );
                 for r in &rows {
                     t.push_str(&format!(
-                        "| {} | {} | {} | {} | {} | {:.3} | {:.2} | {:.3e} | {:.3e} |\n",
+                        "| {} | {} | {} | {} | {} | {:.4} | {:.4} | {:.2} | {:.3e} | {:.3e} |\n",
                         r.mesh,
                         r.input_triangles,
                         r.method,
                         r.ratio,
                         r.triangles,
                         r.seconds,
+                        r.median_seconds,
                         r.mtri_per_s,
                         r.hausdorff_relative,
                         r.mean_relative

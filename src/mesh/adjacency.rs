@@ -32,6 +32,7 @@ use glam::{Vec2, Vec3};
 use smallvec::SmallVec;
 
 use super::Mesh;
+use super::incidence::Incidence;
 
 /// A short list of vertices, triangles or wedges: the local operations build these per call, and on
 /// the stack (the usual valence fits) they cost no allocation.
@@ -42,6 +43,23 @@ pub type WedgeMap = SmallVec<[(u32, u32); 4]>;
 
 /// Every live edge (a < b) with its live triangles (ascending), in edge order.
 pub type EdgeList = Vec<((u32, u32), SmallVec<[u32; 2]>)>;
+
+/// How many values two ascending, duplicate-free lists share.
+fn sorted_common(x: &[u32], y: &[u32]) -> usize {
+    let (mut i, mut j, mut n) = (0, 0, 0);
+    while i < x.len() && j < y.len() {
+        match x[i].cmp(&y[j]) {
+            std::cmp::Ordering::Less => i += 1,
+            std::cmp::Ordering::Greater => j += 1,
+            std::cmp::Ordering::Equal => {
+                n += 1;
+                i += 1;
+                j += 1;
+            }
+        }
+    }
+    n
+}
 
 /// [`Adjacency`]'s marker for a vertex with several wedges.
 const SEVERAL: u32 = u32::MAX;
@@ -84,7 +102,7 @@ pub struct Adjacency {
     corners: Vec<[u32; 3]>,
     materials: Vec<u32>,
     alive: Vec<bool>,
-    vtris: Vec<Vec<u32>>,
+    vtris: Incidence,
     class: Vec<VertexClass>,
     /// Explicitly locked vertices ([`Adjacency::lock`]).
     locked: Vec<bool>,
@@ -152,7 +170,7 @@ impl Adjacency {
                 .iter()
                 .map(|t| t[0] != t[1] && t[1] != t[2] && t[0] != t[2])
                 .collect(),
-            vtris: vec![Vec::new(); positions.len()],
+            vtris: Incidence::default(),
             class: vec![VertexClass::Interior; positions.len()],
             locked: vec![false; positions.len()],
             only_wedge: Vec::new(),
@@ -166,14 +184,8 @@ impl Adjacency {
             has_uvs: mesh.uvs().is_some(),
             has_colors: mesh.colors().is_some(),
         };
-        for t in 0..adj.tris.len() {
-            if adj.alive[t] {
-                adj.alive_count += 1;
-                for v in adj.tris[t] {
-                    adj.vtris[v as usize].push(t as u32);
-                }
-            }
-        }
+        adj.alive_count = adj.alive.iter().filter(|&&a| a).count();
+        adj.vtris = Incidence::build(adj.positions.len(), &adj.tris, &adj.alive);
         adj.only_wedge = (0..adj.positions.len() as u32)
             .map(|v| match adj.vertex_wedges(v).as_slice() {
                 &[w] => w,
@@ -211,7 +223,7 @@ impl Adjacency {
 
     /// The wedges used by `v`'s corners, ascending.
     pub fn vertex_wedges(&self, v: u32) -> Local<u32> {
-        let ts = &self.vtris[v as usize];
+        let ts = self.vtris.get(v);
         match self.only_wedge.get(v as usize) {
             Some(&w) if w != SEVERAL && !ts.is_empty() => return Local::from_slice(&[w]),
             _ => {}
@@ -275,23 +287,33 @@ impl Adjacency {
 
     /// Every live edge (a < b) with its live triangles, in edge order.
     pub fn edge_map(&self) -> EdgeList {
-        let mut half: Vec<((u32, u32), u32)> = Vec::with_capacity(3 * self.alive_count);
-        for t in self.live_triangles() {
-            let x = self.tris[t as usize];
-            for k in 0..3 {
-                let (a, b) = (x[k], x[(k + 1) % 3]);
-                half.push(((a.min(b), a.max(b)), t));
-            }
-        }
-        half.sort_unstable();
-        let mut edges: EdgeList = Vec::with_capacity(half.len() / 2 + 1);
-        for (e, t) in half {
-            match edges.last_mut() {
-                Some((last, ts)) if *last == e => ts.push(t),
-                _ => edges.push((e, SmallVec::from_slice(&[t]))),
+        let mut edges: EdgeList = Vec::with_capacity(3 * self.alive_count / 2 + 1);
+        let mut pairs: Local<(u32, u32)> = Local::new();
+        for a in 0..self.positions.len() as u32 {
+            // a's edges to higher vertices, from a's own triangles: (other end, triangle) sorted
+            // is edge order, with each edge's triangles ascending.
+            self.higher_ends(a, &mut pairs);
+            for &(b, t) in &pairs {
+                match edges.last_mut() {
+                    Some((last, ts)) if *last == (a, b) => ts.push(t),
+                    _ => edges.push(((a, b), SmallVec::from_slice(&[t]))),
+                }
             }
         }
         edges
+    }
+
+    /// The (b, t) with b > a a vertex of a's triangle t, sorted, into `out`.
+    fn higher_ends(&self, a: u32, out: &mut Local<(u32, u32)>) {
+        out.clear();
+        for &t in self.vtris.get(a) {
+            for b in self.tris[t as usize] {
+                if b > a {
+                    out.push((b, t));
+                }
+            }
+        }
+        out.sort_unstable();
     }
 
     /// Whether the edge ab between triangles `ts` (two of them) is a seam: a or b has different
@@ -361,16 +383,26 @@ impl Adjacency {
 
     /// Triangles incident to `v`.
     pub fn vertex_triangles(&self, v: u32) -> &[u32] {
-        &self.vtris[v as usize]
+        self.vtris.get(v)
+    }
+
+    /// Ask for the cache line where `v`'s triangle list starts. A hint only.
+    pub fn prefetch_triangles(&self, v: u32) {
+        if let Some(first) = self.vtris.first(v) {
+            crate::prefetch::prefetch(first);
+        }
     }
 
     /// Vertices adjacent to `v`, ascending.
     pub fn neighbours(&self, v: u32) -> Local<u32> {
-        let mut n: Local<u32> = self.vtris[v as usize]
-            .iter()
-            .flat_map(|&t| self.tris[t as usize])
-            .filter(|&x| x != v)
-            .collect();
+        let mut n: Local<u32> = Local::new();
+        for &t in self.vtris.get(v) {
+            for x in self.tris[t as usize] {
+                if x != v {
+                    n.push(x);
+                }
+            }
+        }
         n.sort_unstable();
         n.dedup();
         n
@@ -378,7 +410,8 @@ impl Adjacency {
 
     /// Live triangles containing both `a` and `b`.
     pub fn edge_triangles(&self, a: u32, b: u32) -> Local<u32> {
-        self.vtris[a as usize]
+        self.vtris
+            .get(a)
             .iter()
             .copied()
             .filter(|&t| self.tris[t as usize].contains(&b))
@@ -387,15 +420,16 @@ impl Adjacency {
 
     /// Every live edge (a < b), ascending.
     pub fn edges(&self) -> Vec<(u32, u32)> {
-        let mut e: Vec<(u32, u32)> = self
-            .live_triangles()
-            .flat_map(|t| {
-                let x = self.tris[t as usize];
-                (0..3).map(move |k| (x[k].min(x[(k + 1) % 3]), x[k].max(x[(k + 1) % 3])))
-            })
-            .collect();
-        e.sort_unstable();
-        e.dedup();
+        let mut e: Vec<(u32, u32)> = Vec::with_capacity(3 * self.alive_count / 2 + 1);
+        let mut pairs: Local<(u32, u32)> = Local::new();
+        for a in 0..self.positions.len() as u32 {
+            self.higher_ends(a, &mut pairs);
+            for &(b, _) in &pairs {
+                if e.last() != Some(&(a, b)) {
+                    e.push((a, b));
+                }
+            }
+        }
         e
     }
 
@@ -416,7 +450,7 @@ impl Adjacency {
         undo.verts.push((
             v,
             self.positions[v as usize],
-            self.vtris[v as usize].clone(),
+            self.vtris.get(v).to_vec(),
             self.class[v as usize],
         ));
     }
@@ -460,7 +494,7 @@ impl Adjacency {
 
     /// [`Adjacency::can_collapse`], returning the triangles on the edge and the wedge map.
     fn check_collapse(&self, a: u32, b: u32, p: Vec3) -> Result<(Local<u32>, WedgeMap), Reject> {
-        if a == b || self.vtris[a as usize].is_empty() || self.vtris[b as usize].is_empty() {
+        if a == b || self.vtris.get(a).is_empty() || self.vtris.get(b).is_empty() {
             return Err(Reject::NoSuchEdge);
         }
         let shared = self.edge_triangles(a, b);
@@ -481,7 +515,7 @@ impl Adjacency {
         // Link condition.
         if !non_manifold {
             let (na, nb) = (self.neighbours(a), self.neighbours(b));
-            let common = na.iter().filter(|x| nb.binary_search(x).is_ok()).count();
+            let common = sorted_common(&na, &nb);
             if common != shared.len() {
                 return Err(Reject::Link);
             }
@@ -498,9 +532,7 @@ impl Adjacency {
             return Err(Reject::Link);
         }
         let map = self.wedge_map(a, b, &shared)?;
-        if self.folds(&self.vtris[a as usize], a, p, b)
-            || self.folds(&self.vtris[b as usize], b, p, a)
-        {
+        if self.folds(self.vtris.get(a), a, p, b) || self.folds(self.vtris.get(b), b, p, a) {
             return Err(Reject::FoldOver);
         }
         Ok((shared, map))
@@ -525,7 +557,7 @@ impl Adjacency {
                 None => map.push((wa, wb)),
             }
         }
-        for &t in &self.vtris[a as usize] {
+        for &t in self.vtris.get(a) {
             let w = self.corner_wedge(t, a);
             if !map.iter().any(|(x, _)| *x == w) {
                 return Err(Reject::Seam);
@@ -547,7 +579,7 @@ impl Adjacency {
         for &v in &touched {
             self.snapshot_vert(&mut undo, v);
         }
-        for &t in &self.vtris[a as usize] {
+        for &t in self.vtris.get(a) {
             self.snapshot_tri(&mut undo, t);
         }
         self.apply_collapse(a, b, p, &shared, &map);
@@ -568,18 +600,19 @@ impl Adjacency {
             self.alive[t as usize] = false;
             self.alive_count -= 1;
             for v in self.tris[t as usize] {
-                self.vtris[v as usize].retain(|&x| x != t);
+                self.vtris.remove(v, t);
             }
         }
-        let moved: Vec<u32> = std::mem::take(&mut self.vtris[a as usize]);
+        // a's triangles (ascending) move to b: merged into b's ascending list.
+        let moved: Local<u32> = Local::from_slice(self.vtris.get(a));
+        self.vtris.clear(a);
         for &t in &moved {
             let k = self.tris[t as usize].iter().position(|&x| x == a).unwrap();
             self.tris[t as usize][k] = b;
             let w = self.corners[t as usize][k];
             self.corners[t as usize][k] = map.iter().find(|(x, _)| *x == w).unwrap().1;
-            self.vtris[b as usize].push(t);
         }
-        self.vtris[b as usize].sort_unstable();
+        self.vtris.merge(b, &moved);
         self.positions[b as usize] = p;
         let (ca, cb) = (self.class[a as usize], self.class[b as usize]);
         self.class[b as usize] = ca.max(cb);
@@ -607,7 +640,7 @@ impl Adjacency {
         }
         self.positions
             .push(0.5 * (self.positions[a as usize] + self.positions[b as usize]));
-        self.vtris.push(Vec::new());
+        self.vtris.push_vertex();
         self.locked.push(false);
         self.only_wedge.push(SEVERAL);
         let border = shared.len() == 1;
@@ -655,19 +688,14 @@ impl Adjacency {
             self.materials.push(self.materials[t as usize]);
             self.alive.push(true);
             self.alive_count += 1;
-            self.vtris[b as usize].retain(|&x| x != t);
+            self.vtris.remove(b, t);
             for v in t2 {
-                self.vtris[v as usize].push(nt);
+                self.vtris.insert(v, nt);
             }
-            self.vtris[m as usize].push(t);
+            self.vtris.insert(m, t);
         }
         if let [(_, w)] = made[..] {
             self.only_wedge[m as usize] = w;
-        }
-        let touched: Vec<u32> = undo.verts.iter().map(|v| v.0).chain([m]).collect();
-        for v in touched {
-            self.vtris[v as usize].sort_unstable();
-            self.vtris[v as usize].dedup();
         }
         Ok((m, undo))
     }
@@ -728,13 +756,10 @@ impl Adjacency {
         self.corners[t1 as usize] = c1;
         self.tris[t2 as usize] = new2;
         self.corners[t2 as usize] = c2;
-        self.vtris[b as usize].retain(|&x| x != t1);
-        self.vtris[a as usize].retain(|&x| x != t2);
-        self.vtris[d as usize].push(t1);
-        self.vtris[c as usize].push(t2);
-        for v in [c, d] {
-            self.vtris[v as usize].sort_unstable();
-        }
+        self.vtris.remove(b, t1);
+        self.vtris.remove(a, t2);
+        self.vtris.insert(d, t1);
+        self.vtris.insert(c, t2);
         Ok(undo)
     }
 
@@ -747,7 +772,7 @@ impl Adjacency {
         }
         for (v, p, vt, class) in undo.verts.into_iter().rev() {
             self.positions[v as usize] = p;
-            self.vtris[v as usize] = vt;
+            self.vtris.set(v, &vt);
             self.class[v as usize] = class;
         }
         let (np, nw, nt) = undo.lens;
@@ -777,7 +802,7 @@ impl Adjacency {
                 return Err(format!("triangle {t} is degenerate: {x:?}"));
             }
             for (k, (&v, &w)) in x.iter().zip(&self.corners[t]).enumerate() {
-                if !self.vtris[v as usize].contains(&(t as u32)) {
+                if !self.vtris.get(v).contains(&(t as u32)) {
                     return Err(format!("vertex {v} does not list triangle {t}"));
                 }
                 if self.wedges[w as usize].vertex != v {
@@ -793,7 +818,10 @@ impl Adjacency {
                 self.alive_count
             ));
         }
-        for (v, ts) in self.vtris.iter().enumerate() {
+        for (v, ts) in self.vtris.to_vecs().iter().enumerate() {
+            if !ts.is_sorted_by(|x, y| x < y) {
+                return Err(format!("vertex {v}'s triangles are not strictly ascending"));
+            }
             let only = self.only_wedge[v];
             if only != SEVERAL && ts.iter().any(|&t| self.corner_wedge(t, v as u32) != only) {
                 return Err(format!(

@@ -24,6 +24,7 @@
 pub mod adjacency;
 mod bounds;
 mod gltf;
+mod incidence;
 mod normals;
 mod obj;
 mod off;

@@ -470,6 +470,22 @@ pub fn run(adj: Adjacency, cost: &mut dyn CollapseCost, stop: Stop, diagonal: f6
         if err > limit {
             break;
         }
+        // A collapse that would take the count below a triangle target ends the run before it
+        // is made: the LOD is then `last` as it stands, the prefix `Progressive::extract` gives,
+        // with no replay from the start. (A refused collapse does not end the prefix, so it is
+        // only checked.)
+        if let Stop::Triangles(n) = stop
+            && adj.triangle_count() - adj.edge_triangles(a, b).len().min(adj.triangle_count()) < n
+        {
+            let legal = adj.can_collapse(a, b, p).is_ok()
+                || (!adj.is_locked(b)
+                    && adj.class(b) <= adj.class(a)
+                    && adj.can_collapse(b, a, p).is_ok());
+            if legal {
+                break;
+            }
+            continue;
+        }
         // A refused collapse changes nothing, so each direction is checked and applied in one go.
         let (from, to, map) = match adj.collapse_for_good(a, b, p) {
             Ok(map) => (a, b, map),
