@@ -44,23 +44,6 @@ pub type WedgeMap = SmallVec<[(u32, u32); 4]>;
 /// Every live edge (a < b) with its live triangles (ascending), in edge order.
 pub type EdgeList = Vec<((u32, u32), SmallVec<[u32; 2]>)>;
 
-/// How many values two ascending, duplicate-free lists share.
-fn sorted_common(x: &[u32], y: &[u32]) -> usize {
-    let (mut i, mut j, mut n) = (0, 0, 0);
-    while i < x.len() && j < y.len() {
-        match x[i].cmp(&y[j]) {
-            std::cmp::Ordering::Less => i += 1,
-            std::cmp::Ordering::Greater => j += 1,
-            std::cmp::Ordering::Equal => {
-                n += 1;
-                i += 1;
-                j += 1;
-            }
-        }
-    }
-    n
-}
-
 /// [`Adjacency`]'s marker for a vertex with several wedges.
 const SEVERAL: u32 = u32::MAX;
 
@@ -197,18 +180,20 @@ impl Adjacency {
     }
 
     fn classify(&mut self) {
-        for ((a, b), ts) in &self.edge_map() {
+        let mut class = std::mem::take(&mut self.class);
+        self.for_each_edge(|a, b, ts| {
             let c = match ts.len() {
                 1 => VertexClass::Border,
-                2 if self.is_seam(*a, *b, ts) => VertexClass::Seam,
+                2 if self.is_seam(a, b, ts) => VertexClass::Seam,
                 2 => VertexClass::Interior,
                 _ => VertexClass::NonManifold,
             };
-            for v in [*a, *b] {
-                let cur = &mut self.class[v as usize];
+            for v in [a, b] {
+                let cur = &mut class[v as usize];
                 *cur = (*cur).max(c);
             }
-        }
+        });
+        self.class = class;
     }
 
     /// Whether the mesh has texture coordinates (wedge UVs are meaningful).
@@ -288,19 +273,30 @@ impl Adjacency {
     /// Every live edge (a < b) with its live triangles, in edge order.
     pub fn edge_map(&self) -> EdgeList {
         let mut edges: EdgeList = Vec::with_capacity(3 * self.alive_count / 2 + 1);
+        self.for_each_edge(|a, b, ts| edges.push(((a, b), SmallVec::from_slice(ts))));
+        edges
+    }
+
+    /// Call `f(a, b, triangles)` for every live edge (a < b) with its live triangles (ascending),
+    /// in edge order, without collecting them.
+    pub fn for_each_edge(&self, mut f: impl FnMut(u32, u32, &[u32])) {
         let mut pairs: Local<(u32, u32)> = Local::new();
+        let mut ts: Local<u32> = Local::new();
         for a in 0..self.positions.len() as u32 {
             // a's edges to higher vertices, from a's own triangles: (other end, triangle) sorted
             // is edge order, with each edge's triangles ascending.
             self.higher_ends(a, &mut pairs);
-            for &(b, t) in &pairs {
-                match edges.last_mut() {
-                    Some((last, ts)) if *last == (a, b) => ts.push(t),
-                    _ => edges.push(((a, b), SmallVec::from_slice(&[t]))),
+            let mut i = 0;
+            while i < pairs.len() {
+                let b = pairs[i].0;
+                ts.clear();
+                while i < pairs.len() && pairs[i].0 == b {
+                    ts.push(pairs[i].1);
+                    i += 1;
                 }
+                f(a, b, &ts);
             }
         }
-        edges
     }
 
     /// The (b, t) with b > a a vertex of a's triangle t, sorted, into `out`.
@@ -395,16 +391,23 @@ impl Adjacency {
 
     /// Vertices adjacent to `v`, ascending.
     pub fn neighbours(&self, v: u32) -> Local<u32> {
+        let mut n = self.ring(v);
+        n.sort_unstable();
+        n
+    }
+
+    /// Vertices adjacent to `v`, each once, in no particular order (what a caller that only
+    /// visits or counts them needs; no sort).
+    pub fn ring(&self, v: u32) -> Local<u32> {
         let mut n: Local<u32> = Local::new();
         for &t in self.vtris.get(v) {
             for x in self.tris[t as usize] {
-                if x != v {
+                // Valences are small: a scan of what is there beats sorting afterwards.
+                if x != v && !n.contains(&x) {
                     n.push(x);
                 }
             }
         }
-        n.sort_unstable();
-        n.dedup();
         n
     }
 
@@ -514,8 +517,8 @@ impl Adjacency {
         }
         // Link condition.
         if !non_manifold {
-            let (na, nb) = (self.neighbours(a), self.neighbours(b));
-            let common = sorted_common(&na, &nb);
+            let na = self.ring(a);
+            let common = self.ring(b).iter().filter(|x| na.contains(x)).count();
             if common != shared.len() {
                 return Err(Reject::Link);
             }
@@ -841,18 +844,16 @@ impl Adjacency {
 
     /// Edges used by more than two live triangles.
     pub fn non_manifold_edges(&self) -> usize {
-        self.edge_map()
-            .iter()
-            .filter(|(_, ts)| ts.len() > 2)
-            .count()
+        let mut n = 0;
+        self.for_each_edge(|_, _, ts| n += usize::from(ts.len() > 2));
+        n
     }
 
     /// Border edges (one live triangle).
     pub fn border_edges(&self) -> usize {
-        self.edge_map()
-            .iter()
-            .filter(|(_, ts)| ts.len() == 1)
-            .count()
+        let mut n = 0;
+        self.for_each_edge(|_, _, ts| n += usize::from(ts.len() == 1));
+        n
     }
 
     /// The current mesh: one output vertex per used wedge, at its welded vertex's position.

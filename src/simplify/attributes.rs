@@ -51,7 +51,7 @@ pub struct AttributeQuadrics {
     color_s: f64,
 }
 
-fn tri_index(n: usize, i: usize, j: usize) -> usize {
+const fn tri_index(n: usize, i: usize, j: usize) -> usize {
     let (i, j) = if i <= j { (i, j) } else { (j, i) };
     i * n - i * (i + 1) / 2 + j
 }
@@ -191,117 +191,158 @@ impl AttributeQuadrics {
 
     /// The value part of [`AttributeQuadrics::optimal`] alone (what a queued edge's cost needs).
     pub fn cost(&self, wedges: &[u32], x: DVec3, keep: &Wedge) -> f64 {
-        self.solve(wedges, x, keep, &mut [0.0; MAX_M])
+        self.solve_n::<false>(wedges, x, keep, &mut [0.0; MAX_M])
     }
 
-    /// The optimal attributes into `attrs` and the quadric's value there.
+    /// The quadric's minimum over the attributes at position `x` (the attributes into `attrs`
+    /// when `WANT_ATTRS`).
     fn solve(&self, wedges: &[u32], x: DVec3, keep: &Wedge, attrs: &mut [f64; MAX_M]) -> f64 {
-        // One instance per dimension, so every loop below has a constant trip count (this runs
-        // for every queued edge; the instances unroll).
-        match self.n() {
-            6 => self.optimal_n::<6>(wedges, x, keep, attrs),
-            8 => self.optimal_n::<8>(wedges, x, keep, attrs),
-            9 => self.optimal_n::<9>(wedges, x, keep, attrs),
-            11 => self.optimal_n::<11>(wedges, x, keep, attrs),
-            n => unreachable!("attribute quadrics of dimension {n}"),
-        }
+        self.solve_n::<true>(wedges, x, keep, attrs)
     }
 
-    // Dense linear algebra on fixed-size arrays: index loops read like the formulas.
-    #[allow(clippy::needless_range_loop)]
-    fn optimal_n<const N: usize>(
+    fn solve_n<const WANT_ATTRS: bool>(
         &self,
         wedges: &[u32],
         x: DVec3,
         keep: &Wedge,
         attrs: &mut [f64; MAX_M],
     ) -> f64 {
-        let (n, m) = (N, N - 3);
-        let stride = n * (n + 1) / 2 + n + 1;
+        // One instance per dimension, so every loop below has a constant trip count and every
+        // packed index is a constant (this runs for every queued edge; the instances unroll).
+        match self.n() {
+            6 => self.reduced::<6, WANT_ATTRS>(wedges, x, keep, attrs),
+            8 => self.reduced::<8, WANT_ATTRS>(wedges, x, keep, attrs),
+            9 => self.reduced::<9, WANT_ATTRS>(wedges, x, keep, attrs),
+            11 => self.reduced::<11, WANT_ATTRS>(wedges, x, keep, attrs),
+            n => unreachable!("attribute quadrics of dimension {n}"),
+        }
+    }
+
+    /// The summed quadric's minimum over the attributes with the position held at `x`, by the
+    /// Schur complement: with r = A_ax·x + b_a and A_aa = L·Lᵀ (Cholesky),
+    /// min over a of Q(x, a) = xᵀA_xx·x + 2·b_x·x + c − |L⁻¹r|², at a∗ = −L⁻ᵀ(L⁻¹r).
+    /// Where A_aa is singular (too few faces) the attributes stay at `keep`'s and the value is
+    /// the quadric there.
+    // Dense linear algebra on fixed-size arrays: index loops read like the formulas.
+    #[allow(clippy::needless_range_loop)]
+    fn reduced<const N: usize, const WANT_ATTRS: bool>(
+        &self,
+        wedges: &[u32],
+        x: DVec3,
+        keep: &Wedge,
+        attrs: &mut [f64; MAX_M],
+    ) -> f64 {
+        let m = N - 3;
+        let stride = N * (N + 1) / 2 + N + 1;
         debug_assert_eq!(stride, self.stride);
-        let off = n * (n + 1) / 2;
-        // Sum the wedges' quadrics straight into the unpacked symmetric matrix, b and c (the
-        // packed index arithmetic per access cost more than the solve; arrays sized by N so
-        // nothing larger is cleared per call).
-        let mut full = [[0.0f64; N]; N];
-        let mut bv = [0.0f64; N];
-        let mut c = 0.0f64;
-        for &w in wedges {
-            let d = &self.data[w as usize * stride..(w as usize + 1) * stride];
-            let mut k = 0;
-            for i in 0..n {
-                for j in i..n {
-                    full[i][j] += d[k];
-                    k += 1;
+        let off = N * (N + 1) / 2;
+        // Sum the wedges' packed quadrics.
+        let mut q = [0.0f64; STRIDE_MAX];
+        let quadric = |w: u32| &self.data[w as usize * stride..(w as usize + 1) * stride];
+        // The first two at once (a collapse's usual group; no copy of the first on its own).
+        let d0 = quadric(wedges[0]);
+        match wedges.get(1) {
+            Some(&w1) => {
+                let d1 = quadric(w1);
+                for k in 0..stride {
+                    q[k] = d0[k] + d1[k];
                 }
             }
-            for i in 0..n {
-                bv[i] += d[off + i];
-            }
-            c += d[off + n];
-        }
-        for i in 0..n {
-            for j in 0..i {
-                full[i][j] = full[j][i];
+            None => {
+                for k in 0..stride {
+                    q[k] = d0[k];
+                }
             }
         }
-        let a = |i: usize, j: usize| full[i][j];
-        // Solve A_aa · a = −(A_ax · x + b_a) by Cholesky.
-        let mut l = [[0.0f64; N]; N];
-        let mut rhs = [0.0f64; N];
-        for i in 0..m {
-            rhs[i] = -(a(3 + i, 0) * x.x + a(3 + i, 1) * x.y + a(3 + i, 2) * x.z + bv[3 + i]);
+        for &w in wedges.iter().skip(2) {
+            let d = quadric(w);
+            for k in 0..stride {
+                q[k] += d[k];
+            }
         }
+        let at = |i: usize, j: usize| q[tri_index(N, i, j)];
+        let xs = [x.x, x.y, x.z];
+        // The position-only part: xᵀA_xx·x + 2·b_x·x + c.
+        let mut base = q[off + N];
+        for i in 0..3 {
+            let mut row = 0.0;
+            for j in 0..3 {
+                row += at(i, j) * xs[j];
+            }
+            base += xs[i] * (row + 2.0 * q[off + i]);
+        }
+        // r = A_ax·x + b_a.
+        let mut r = [0.0f64; MAX_M];
+        for k in 0..m {
+            r[k] =
+                at(3 + k, 0) * xs[0] + at(3 + k, 1) * xs[1] + at(3 + k, 2) * xs[2] + q[off + 3 + k];
+        }
+        // Cholesky of A_aa; a pivot below 1e-12 of its trace counts as singular.
+        let mut l = [[0.0f64; MAX_M]; MAX_M];
+        let mut trace = 0.0;
+        for k in 0..m {
+            trace += at(3 + k, 3 + k);
+        }
+        let tiny = 1e-12 * trace.max(1e-300);
         let mut ok = true;
-        let trace: f64 = (0..m).map(|i| a(3 + i, 3 + i)).sum();
-        for i in 0..m {
+        'outer: for i in 0..m {
             for j in 0..=i {
-                let mut s = a(3 + i, 3 + j);
+                let mut s = at(3 + i, 3 + j);
                 for k in 0..j {
                     s -= l[i][k] * l[j][k];
                 }
                 if i == j {
-                    if s <= 1e-12 * trace.max(1e-300) {
+                    if s <= tiny {
                         ok = false;
-                        break;
+                        break 'outer;
                     }
                     l[i][i] = s.sqrt();
                 } else {
                     l[i][j] = s / l[j][j];
                 }
             }
-            if !ok {
-                break;
-            }
         }
-        let mut v = [0.0; N];
-        v[..3].copy_from_slice(&x.to_array());
         if ok {
-            let mut y = [0.0; N];
+            // y = L⁻¹r; the minimum is base − |y|².
+            let mut y = [0.0f64; MAX_M];
+            let mut yy = 0.0;
             for i in 0..m {
-                let mut s = rhs[i];
+                let mut s = r[i];
                 for k in 0..i {
                     s -= l[i][k] * y[k];
                 }
                 y[i] = s / l[i][i];
+                yy += y[i] * y[i];
             }
-            for i in (0..m).rev() {
-                let mut s = y[i];
-                for k in i + 1..m {
-                    s -= l[k][i] * v[3 + k];
+            if WANT_ATTRS {
+                // a∗ = −L⁻ᵀy.
+                for i in (0..m).rev() {
+                    let mut s = y[i];
+                    for k in i + 1..m {
+                        s -= l[k][i] * attrs[k];
+                    }
+                    attrs[i] = s / l[i][i];
                 }
-                v[3 + i] = s / l[i][i];
+                for a in attrs.iter_mut().take(m) {
+                    *a = -*a;
+                }
             }
-        } else {
-            self.attrs_into(keep, &mut v[3..]);
+            return (base - yy).max(0.0);
         }
-        // Value at v.
-        let mut val = c;
-        for i in 0..n {
-            let row: f64 = (0..n).map(|j| full[i][j] * v[j]).sum();
-            val += v[i] * (row + 2.0 * bv[i]);
+        // Singular: the quadric at (x, keep's attributes).
+        let mut a = [0.0f64; MAX_M];
+        self.attrs_into(keep, &mut a);
+        let mut val = base;
+        for k in 0..m {
+            let mut row = 0.0;
+            for j in 0..m {
+                row += at(3 + k, 3 + j) * a[j];
+            }
+            val += a[k] * (row + 2.0 * r[k]);
         }
-        attrs[..m].copy_from_slice(&v[3..]);
+        if WANT_ATTRS {
+            attrs[..m].copy_from_slice(&a[..m]);
+        }
         val.max(0.0)
     }
 

@@ -174,24 +174,24 @@ impl QemCost {
                 }
             }
         }
-        for ((x, y), ts) in adj.edge_map() {
+        adj.for_each_edge(|x, y, ts| {
             let weight = match ts.len() {
                 1 => BORDER_WEIGHT,
-                2 if adj.is_seam(x, y, &ts) => SEAM_WEIGHT,
-                _ => continue,
+                2 if adj.is_seam(x, y, ts) => SEAM_WEIGHT,
+                _ => return,
             };
             let [a, b, c] = adj.triangle(ts[0]);
             let face = (pos(b) - pos(a)).cross(pos(c) - pos(a));
             let e = pos(y) - pos(x);
             let n = e.cross(face);
             if n.length_squared() <= 0.0 {
-                continue;
+                return;
             }
             let n = n.normalize();
             let k = Quadric::plane(n, -n.dot(pos(x)), weight * e.length_squared());
             q[x as usize] = q[x as usize].add(&k);
             q[y as usize] = q[y as usize].add(&k);
-        }
+        });
         QemCost {
             quadrics: q,
             attributes: None,
@@ -510,7 +510,7 @@ pub fn run(adj: Adjacency, cost: &mut dyn CollapseCost, stop: Stop, diagonal: f6
         });
         // Only the edges around `to` changed (its quadric and position); their old entries
         // carry `to`'s old version and are skipped when popped.
-        let ring = adj.neighbours(to);
+        let ring = adj.ring(to);
         for &n in &ring {
             cost.prefetch(&adj, n);
         }
