@@ -169,31 +169,87 @@ impl Adjacency {
         };
         adj.alive_count = adj.alive.iter().filter(|&&a| a).count();
         adj.vtris = Incidence::build(adj.positions.len(), &adj.tris, &adj.alive);
-        adj.only_wedge = (0..adj.positions.len() as u32)
-            .map(|v| match adj.vertex_wedges(v).as_slice() {
-                &[w] => w,
-                _ => SEVERAL,
-            })
-            .collect();
+        // Each vertex's wedge if all its corners share one (one pass over the corners).
+        const UNSEEN: u32 = SEVERAL - 1;
+        let mut only = vec![UNSEEN; adj.positions.len()];
+        for (t, (tri, corners)) in adj.tris.iter().zip(&adj.corners).enumerate() {
+            if adj.alive[t] {
+                for (&v, &w) in tri.iter().zip(corners) {
+                    let o = &mut only[v as usize];
+                    if *o == UNSEEN {
+                        *o = w;
+                    } else if *o != w {
+                        *o = SEVERAL;
+                    }
+                }
+            }
+        }
+        for o in &mut only {
+            if *o == UNSEEN {
+                *o = SEVERAL;
+            }
+        }
+        adj.only_wedge = only;
         adj.classify();
         adj
     }
 
     fn classify(&mut self) {
-        let mut class = std::mem::take(&mut self.class);
-        self.for_each_edge(|a, b, ts| {
-            let c = match ts.len() {
-                1 => VertexClass::Border,
-                2 if self.is_seam(a, b, ts) => VertexClass::Seam,
-                2 => VertexClass::Interior,
-                _ => VertexClass::NonManifold,
-            };
-            for v in [a, b] {
-                let cur = &mut class[v as usize];
-                *cur = (*cur).max(c);
+        // Per vertex a, its edges to higher vertices b, from a's own triangles: how many
+        // triangles each has, and the wedges of a and b in the first two (a seam is an edge of
+        // two triangles whose sides differ in a's or b's wedge). Valences are small, so a scan
+        // of the few edges found so far finds b.
+        struct Seen {
+            b: u32,
+            count: u32,
+            wedges: [[u32; 2]; 2],
+        }
+        let mut seen: SmallVec<[Seen; 16]> = SmallVec::new();
+        for a in 0..self.positions.len() as u32 {
+            seen.clear();
+            for &t in self.vtris.get(a) {
+                let (tri, corners) = (self.tris[t as usize], self.corners[t as usize]);
+                let ka = if tri[0] == a {
+                    0
+                } else if tri[1] == a {
+                    1
+                } else {
+                    2
+                };
+                for kb in [(ka + 1) % 3, (ka + 2) % 3] {
+                    let b = tri[kb];
+                    if b < a {
+                        continue;
+                    }
+                    let pair = [corners[ka], corners[kb]];
+                    match seen.iter_mut().find(|s| s.b == b) {
+                        Some(s) => {
+                            if s.count == 1 {
+                                s.wedges[1] = pair;
+                            }
+                            s.count += 1;
+                        }
+                        None => seen.push(Seen {
+                            b,
+                            count: 1,
+                            wedges: [pair, pair],
+                        }),
+                    }
+                }
             }
-        });
-        self.class = class;
+            for s in &seen {
+                let c = match s.count {
+                    1 => VertexClass::Border,
+                    2 if s.wedges[0] != s.wedges[1] => VertexClass::Seam,
+                    2 => VertexClass::Interior,
+                    _ => VertexClass::NonManifold,
+                };
+                for v in [a, s.b] {
+                    let cur = &mut self.class[v as usize];
+                    *cur = (*cur).max(c);
+                }
+            }
+        }
     }
 
     /// Whether the mesh has texture coordinates (wedge UVs are meaningful).
@@ -279,10 +335,19 @@ impl Adjacency {
 
     /// Call `f(a, b, triangles)` for every live edge (a < b) with its live triangles (ascending),
     /// in edge order, without collecting them.
-    pub fn for_each_edge(&self, mut f: impl FnMut(u32, u32, &[u32])) {
+    pub fn for_each_edge(&self, f: impl FnMut(u32, u32, &[u32])) {
+        self.for_each_edge_from(|_| true, f);
+    }
+
+    /// [`Adjacency::for_each_edge`] for the edges whose lower vertex passes `from`.
+    pub fn for_each_edge_from(
+        &self,
+        from: impl Fn(u32) -> bool,
+        mut f: impl FnMut(u32, u32, &[u32]),
+    ) {
         let mut pairs: Local<(u32, u32)> = Local::new();
         let mut ts: Local<u32> = Local::new();
-        for a in 0..self.positions.len() as u32 {
+        for a in (0..self.positions.len() as u32).filter(|&a| from(a)) {
             // a's edges to higher vertices, from a's own triangles: (other end, triangle) sorted
             // is edge order, with each edge's triangles ascending.
             self.higher_ends(a, &mut pairs);

@@ -72,9 +72,25 @@ impl AttributeQuadrics {
             normal_s: NORMAL_SCALE * diagonal,
             color_s: COLOR_SCALE * diagonal,
         };
+        // One instance per dimension (constant trip counts and packed indices).
+        match n {
+            6 => q.fill::<6>(adj),
+            8 => q.fill::<8>(adj),
+            9 => q.fill::<9>(adj),
+            11 => q.fill::<11>(adj),
+            n => unreachable!("attribute quadrics of dimension {n}"),
+        }
+        q
+    }
+
+    /// Add every live triangle's generalized quadric to its three wedges.
+    fn fill<const N: usize>(&mut self, adj: &Adjacency) {
+        let stride = N * (N + 1) / 2 + N + 1;
+        let off = N * (N + 1) / 2;
+        let dot = |a: &[f64; MAX_N], b: &[f64; MAX_N]| (0..N).map(|i| a[i] * b[i]).sum::<f64>();
         for t in adj.live_triangles() {
             let corners = adj.corners(t);
-            let pts: [[f64; MAX_N]; 3] = corners.map(|w| q.point(adj, w));
+            let pts: [[f64; MAX_N]; 3] = corners.map(|w| self.point(adj, w));
             let (p0, p1, p2) = (&pts[0], &pts[1], &pts[2]);
             let geo = |p: &[f64; MAX_N]| DVec3::new(p[0], p[1], p[2]);
             let area = 0.5 * (geo(p1) - geo(p0)).cross(geo(p2) - geo(p0)).length();
@@ -84,45 +100,43 @@ impl AttributeQuadrics {
             // Orthonormal basis of the triangle's plane in R^n (Gram–Schmidt).
             let mut e1 = [0.0; MAX_N];
             let mut e2 = [0.0; MAX_N];
-            for i in 0..n {
+            for i in 0..N {
                 e1[i] = p1[i] - p0[i];
                 e2[i] = p2[i] - p0[i];
             }
-            let l1 = dot(&e1, &e1, n).sqrt();
+            let l1 = dot(&e1, &e1).sqrt();
             if l1 <= 0.0 {
                 continue;
             }
-            e1.iter_mut().take(n).for_each(|x| *x /= l1);
-            let d = dot(&e1, &e2, n);
-            for i in 0..n {
+            e1.iter_mut().take(N).for_each(|x| *x /= l1);
+            let d = dot(&e1, &e2);
+            for i in 0..N {
                 e2[i] -= d * e1[i];
             }
-            let l2 = dot(&e2, &e2, n).sqrt();
+            let l2 = dot(&e2, &e2).sqrt();
             if l2 <= 1e-300 {
                 continue;
             }
-            e2.iter_mut().take(n).for_each(|x| *x /= l2);
-            let (pe1, pe2) = (dot(p0, &e1, n), dot(p0, &e2, n));
+            e2.iter_mut().take(N).for_each(|x| *x /= l2);
+            let (pe1, pe2) = (dot(p0, &e1), dot(p0, &e2));
             let mut k = [0.0; STRIDE_MAX];
-            for i in 0..n {
-                for j in i..n {
+            for i in 0..N {
+                for j in i..N {
                     let id = if i == j { 1.0 } else { 0.0 };
-                    k[tri_index(n, i, j)] = area * (id - e1[i] * e1[j] - e2[i] * e2[j]);
+                    k[tri_index(N, i, j)] = area * (id - e1[i] * e1[j] - e2[i] * e2[j]);
                 }
             }
-            let off = n * (n + 1) / 2;
-            for i in 0..n {
+            for i in 0..N {
                 k[off + i] = area * (pe1 * e1[i] + pe2 * e2[i] - p0[i]);
             }
-            k[off + n] = area * (dot(p0, p0, n) - pe1 * pe1 - pe2 * pe2);
+            k[off + N] = area * (dot(p0, p0) - pe1 * pe1 - pe2 * pe2);
             for w in corners {
                 let base = w as usize * stride;
-                for (dst, src) in q.data[base..base + stride].iter_mut().zip(&k[..stride]) {
+                for (dst, src) in self.data[base..base + stride].iter_mut().zip(&k[..stride]) {
                     *dst += src;
                 }
             }
         }
-        q
     }
 
     fn n(&self) -> usize {
@@ -372,10 +386,6 @@ impl AttributeQuadrics {
         }
         w
     }
-}
-
-fn dot(a: &[f64; MAX_N], b: &[f64; MAX_N], n: usize) -> f64 {
-    (0..n).map(|i| a[i] * b[i]).sum()
 }
 
 #[cfg(test)]

@@ -33,7 +33,7 @@ use super::attributes::AttributeQuadrics;
 use super::queue::MinQueue;
 use crate::error::Result;
 use crate::mesh::Mesh;
-use crate::mesh::adjacency::{Adjacency, Local, Wedge};
+use crate::mesh::adjacency::{Adjacency, Local, VertexClass, Wedge};
 
 /// Weight of border constraint planes (× edge length²).
 pub const BORDER_WEIGHT: f64 = 1000.0;
@@ -174,7 +174,10 @@ impl QemCost {
                 }
             }
         }
-        adj.for_each_edge(|x, y, ts| {
+        // Border and seam edges join two vertices of those classes (or non-manifold ones), so
+        // only their edges are walked (in edge order, as every other walk).
+        let special = |v: u32| adj.class(v) != VertexClass::Interior;
+        adj.for_each_edge_from(special, |x, y, ts| {
             let weight = match ts.len() {
                 1 => BORDER_WEIGHT,
                 2 if adj.is_seam(x, y, ts) => SEAM_WEIGHT,
