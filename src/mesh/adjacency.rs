@@ -99,6 +99,10 @@ pub struct Adjacency {
     alive_count: usize,
     has_uvs: bool,
     has_colors: bool,
+    /// Scratch for [`Adjacency::collapse_for_good`]: a vertex is marked when its entry equals
+    /// `mark` (a fresh value per use, so nothing is cleared between uses). Not part of the state.
+    marks: Vec<u32>,
+    mark: u32,
 }
 
 /// Why an operation was refused.
@@ -166,6 +170,8 @@ impl Adjacency {
             alive_count: 0,
             has_uvs: mesh.uvs().is_some(),
             has_colors: mesh.colors().is_some(),
+            marks: Vec::new(),
+            mark: 0,
         };
         adj.alive_count = adj.alive.iter().filter(|&&a| a).count();
         adj.vtris = Incidence::build(adj.positions.len(), &adj.tris, &adj.alive);
@@ -464,10 +470,30 @@ impl Adjacency {
     /// Vertices adjacent to `v`, each once, in no particular order (what a caller that only
     /// visits or counts them needs; no sort).
     pub fn ring(&self, v: u32) -> Local<u32> {
+        // Valences are small: a scan of what is there beats sorting afterwards, and a plain
+        // array beats a small vector's bookkeeping (this runs three times per collapse).
+        const ROOM: usize = 32;
+        let mut found = [0u32; ROOM];
+        let mut n = 0;
+        for &t in self.vtris.get(v) {
+            for x in self.tris[t as usize] {
+                if x != v && !found[..n].contains(&x) {
+                    if n == ROOM {
+                        return self.ring_large(v);
+                    }
+                    found[n] = x;
+                    n += 1;
+                }
+            }
+        }
+        Local::from_slice(&found[..n])
+    }
+
+    /// [`Adjacency::ring`] of a vertex with more than 32 neighbours.
+    fn ring_large(&self, v: u32) -> Local<u32> {
         let mut n: Local<u32> = Local::new();
         for &t in self.vtris.get(v) {
             for x in self.tris[t as usize] {
-                // Valences are small: a scan of what is there beats sorting afterwards.
                 if x != v && !n.contains(&x) {
                     n.push(x);
                 }
@@ -532,23 +558,33 @@ impl Adjacency {
     }
 
     /// Would moving the corner `v` of the triangles in `ts` to `p` flip or flatten any of them?
+    ///
+    /// A triangle (v, i, j) has the normal (p_i − v) × (p_j − v); it folds when the new normal is
+    /// below 1e-12 of the old one's length (degenerate) or points away from it. Lengths are
+    /// compared squared, in f64 (no square roots; no underflow on tiny models).
     fn folds(&self, ts: &[u32], v: u32, p: Vec3, skip_with: u32) -> bool {
+        let pv = self.positions[v as usize];
         for &t in ts {
             let tri = self.tris[t as usize];
             if tri.contains(&skip_with) {
                 continue;
             }
-            let old = tri.map(|x| self.positions[x as usize]);
-            let new = tri.map(|x| {
-                if x == v {
-                    p
-                } else {
-                    self.positions[x as usize]
-                }
-            });
-            let (no, nn) = (Self::face_normal(old), Self::face_normal(new));
-            let (lo, ln) = (no.length(), nn.length());
-            if ln <= 1e-12 * (lo + 1e-30) || no.dot(nn) <= 0.0 {
+            let k = if tri[0] == v {
+                0
+            } else if tri[1] == v {
+                1
+            } else {
+                2
+            };
+            let pi = self.positions[tri[(k + 1) % 3] as usize];
+            let pj = self.positions[tri[(k + 2) % 3] as usize];
+            let no = (pi - pv).cross(pj - pv);
+            let nn = (pi - p).cross(pj - p);
+            let (lo2, ln2) = (
+                no.as_dvec3().length_squared(),
+                nn.as_dvec3().length_squared(),
+            );
+            if ln2 <= 1e-24 * lo2 || no.dot(nn) <= 0.0 {
                 return true;
             }
         }
@@ -562,6 +598,73 @@ impl Adjacency {
 
     /// [`Adjacency::can_collapse`], returning the triangles on the edge and the wedge map.
     fn check_collapse(&self, a: u32, b: u32, p: Vec3) -> Result<(Local<u32>, WedgeMap), Reject> {
+        self.check_collapse_with(a, b, p, |adj| {
+            let na = adj.ring(a);
+            adj.ring(b).iter().filter(|x| na.contains(x)).count()
+        })
+    }
+
+    /// A fresh mark value (every vertex unmarked for it).
+    fn fresh_mark(&mut self) -> u32 {
+        if self.marks.len() < self.positions.len() {
+            self.marks.resize(self.positions.len(), 0);
+        }
+        self.mark = self.mark.wrapping_add(1);
+        if self.mark == 0 {
+            self.marks.fill(0);
+            self.mark = 1;
+        }
+        self.mark
+    }
+
+    /// How many vertices are neighbours of both `a` and `b` (what the link condition counts),
+    /// by marking a's neighbours.
+    fn common_neighbours(&mut self, a: u32, b: u32) -> usize {
+        let m = self.fresh_mark();
+        for &t in self.vtris.get(a) {
+            for x in self.tris[t as usize] {
+                self.marks[x as usize] = m;
+            }
+        }
+        // a's own mark goes: only its neighbours count (b's neighbour a does not).
+        self.marks[a as usize] = m.wrapping_sub(1);
+        let counted = self.fresh_mark();
+        let mut n = 0;
+        for &t in self.vtris.get(b) {
+            for x in self.tris[t as usize] {
+                if x != b && self.marks[x as usize] == m {
+                    self.marks[x as usize] = counted;
+                    n += 1;
+                }
+            }
+        }
+        n
+    }
+
+    /// `v`'s neighbours into `out` (each once, no particular order), by marking.
+    fn ring_marked(&mut self, v: u32, out: &mut Local<u32>) {
+        out.clear();
+        let m = self.fresh_mark();
+        self.marks[v as usize] = m;
+        for &t in self.vtris.get(v) {
+            for x in self.tris[t as usize] {
+                if self.marks[x as usize] != m {
+                    self.marks[x as usize] = m;
+                    out.push(x);
+                }
+            }
+        }
+    }
+
+    /// [`Adjacency::check_collapse`] with the link condition's count of common neighbours
+    /// from `common` (asked only when the condition applies).
+    fn check_collapse_with(
+        &self,
+        a: u32,
+        b: u32,
+        p: Vec3,
+        common: impl FnOnce(&Adjacency) -> usize,
+    ) -> Result<(Local<u32>, WedgeMap), Reject> {
         if a == b || self.vtris.get(a).is_empty() || self.vtris.get(b).is_empty() {
             return Err(Reject::NoSuchEdge);
         }
@@ -581,12 +684,8 @@ impl Adjacency {
             return Err(Reject::Locked);
         }
         // Link condition.
-        if !non_manifold {
-            let na = self.ring(a);
-            let common = self.ring(b).iter().filter(|x| na.contains(x)).count();
-            if common != shared.len() {
-                return Err(Reject::Link);
-            }
+        if !non_manifold && common(self) != shared.len() {
+            return Err(Reject::Link);
         }
         // Two border vertices joined through the interior would pinch the surface.
         if shared.len() == 2
@@ -655,24 +754,44 @@ impl Adjacency {
     }
 
     /// Collapse `a` into `b`, moving `b` to `p`, without an undo record (for a simplifier that
-    /// never reverts). Returns the wedge map of the collapse; a refused collapse changes nothing.
-    pub fn collapse_for_good(&mut self, a: u32, b: u32, p: Vec3) -> Result<WedgeMap, Reject> {
-        let (shared, map) = self.check_collapse(a, b, p)?;
+    /// never reverts). Returns the wedge map of the collapse and puts b's neighbours afterwards
+    /// into `ring` (each once, no particular order); a refused collapse changes nothing.
+    pub fn collapse_for_good(
+        &mut self,
+        a: u32,
+        b: u32,
+        p: Vec3,
+        ring: &mut Local<u32>,
+    ) -> Result<WedgeMap, Reject> {
+        let common = self.common_neighbours(a, b);
+        let (shared, map) = self.check_collapse_with(a, b, p, |_| common)?;
         self.apply_collapse(a, b, p, &shared, &map);
+        self.ring_marked(b, ring);
         Ok(map)
     }
 
     /// The changes of a checked collapse.
     fn apply_collapse(&mut self, a: u32, b: u32, p: Vec3, shared: &[u32], map: &[(u32, u32)]) {
+        // The triangles on the edge die: the lists of their third vertices lose them here, a's
+        // and b's below.
         for &t in shared {
             self.alive[t as usize] = false;
             self.alive_count -= 1;
             for v in self.tris[t as usize] {
-                self.vtris.remove(v, t);
+                if v != a && v != b {
+                    self.vtris.remove(v, t);
+                }
             }
         }
-        // a's triangles (ascending) move to b: merged into b's ascending list.
-        let moved: Local<u32> = Local::from_slice(self.vtris.get(a));
+        // a's other triangles (ascending) move to b: merged into b's ascending list, which
+        // drops the dead ones.
+        let moved: Local<u32> = self
+            .vtris
+            .get(a)
+            .iter()
+            .copied()
+            .filter(|t| !shared.contains(t))
+            .collect();
         self.vtris.clear(a);
         for &t in &moved {
             let k = self.tris[t as usize].iter().position(|&x| x == a).unwrap();
@@ -680,7 +799,7 @@ impl Adjacency {
             let w = self.corners[t as usize][k];
             self.corners[t as usize][k] = map.iter().find(|(x, _)| *x == w).unwrap().1;
         }
-        self.vtris.merge(b, &moved);
+        self.vtris.retain_merge(b, shared, &moved);
         self.positions[b as usize] = p;
         let (ca, cb) = (self.class[a as usize], self.class[b as usize]);
         self.class[b as usize] = ca.max(cb);
@@ -1072,7 +1191,8 @@ mod tests {
                 if op == 0 && keep {
                     // Collapsing for good leaves the same structure as a collapse with an undo record.
                     let mut other = adj.clone();
-                    let (x, y) = (other.collapse_for_good(a, b, mid), adj.clone().collapse(a, b, mid));
+                    let mut ring = Local::new();
+                    let (x, y) = (other.collapse_for_good(a, b, mid, &mut ring), adj.clone().collapse(a, b, mid));
                     prop_assert_eq!(x.is_ok(), y.is_ok());
                     if x.is_ok() {
                         let mut with_undo = adj.clone();
@@ -1081,6 +1201,9 @@ mod tests {
                         prop_assert_eq!(&other.corners, &with_undo.corners);
                         prop_assert_eq!(&other.vtris, &with_undo.vtris);
                         prop_assert_eq!(&other.positions, &with_undo.positions);
+                        // The ring handed back is b's neighbours afterwards.
+                        ring.sort_unstable();
+                        prop_assert_eq!(ring, other.neighbours(b));
                     }
                 }
                 let result = match op {

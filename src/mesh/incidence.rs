@@ -222,6 +222,22 @@ impl Incidence {
         self.len[v as usize] = (l + items.len()) as u32;
     }
 
+    /// Drop the items of `drop` from `v`'s list, then merge the ascending `items` into it.
+    pub fn retain_merge(&mut self, v: u32, drop: &[u32], items: &[u32]) {
+        let (s, l) = (self.start[v as usize] as usize, self.len[v as usize] as usize);
+        let list = &mut self.data[s..s + l];
+        let mut kept = 0;
+        for i in 0..l {
+            let t = list[i];
+            if !drop.contains(&t) {
+                list[kept] = t;
+                kept += 1;
+            }
+        }
+        self.len[v as usize] = kept as u32;
+        self.merge(v, items);
+    }
+
     /// Every list as its own vector (for tests and comparisons).
     pub fn to_vecs(&self) -> Vec<Vec<u32>> {
         (0..self.len() as u32)

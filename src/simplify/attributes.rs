@@ -34,9 +34,6 @@ pub const NORMAL_SCALE: f64 = 0.005;
 pub const COLOR_SCALE: f64 = 0.1;
 
 const MAX_M: usize = 8;
-const MAX_N: usize = 3 + MAX_M;
-/// Packed size of an n = `MAX_N` quadric.
-const STRIDE_MAX: usize = MAX_N * (MAX_N + 1) / 2 + MAX_N + 1;
 
 /// One generalized quadric per wedge, packed: the upper triangle of A (row-major), then b, then c.
 #[derive(Debug, Clone)]
@@ -74,32 +71,33 @@ impl AttributeQuadrics {
         };
         // One instance per dimension (constant trip counts and packed indices).
         match n {
-            6 => q.fill::<6>(adj),
-            8 => q.fill::<8>(adj),
-            9 => q.fill::<9>(adj),
-            11 => q.fill::<11>(adj),
+            6 => q.fill::<6, 28>(adj),
+            8 => q.fill::<8, 45>(adj),
+            9 => q.fill::<9, 55>(adj),
+            11 => q.fill::<11, 78>(adj),
             n => unreachable!("attribute quadrics of dimension {n}"),
         }
         q
     }
 
-    /// Add every live triangle's generalized quadric to its three wedges.
-    fn fill<const N: usize>(&mut self, adj: &Adjacency) {
-        let stride = N * (N + 1) / 2 + N + 1;
+    /// Add every live triangle's generalized quadric to its three wedges (N dimensions, S
+    /// packed values: every array has its exact size).
+    fn fill<const N: usize, const S: usize>(&mut self, adj: &Adjacency) {
+        debug_assert_eq!(S, N * (N + 1) / 2 + N + 1);
         let off = N * (N + 1) / 2;
-        let dot = |a: &[f64; MAX_N], b: &[f64; MAX_N]| (0..N).map(|i| a[i] * b[i]).sum::<f64>();
+        let dot = |a: &[f64; N], b: &[f64; N]| (0..N).map(|i| a[i] * b[i]).sum::<f64>();
         for t in adj.live_triangles() {
             let corners = adj.corners(t);
-            let pts: [[f64; MAX_N]; 3] = corners.map(|w| self.point(adj, w));
+            let pts: [[f64; N]; 3] = corners.map(|w| self.point::<N>(adj, w));
             let (p0, p1, p2) = (&pts[0], &pts[1], &pts[2]);
-            let geo = |p: &[f64; MAX_N]| DVec3::new(p[0], p[1], p[2]);
+            let geo = |p: &[f64; N]| DVec3::new(p[0], p[1], p[2]);
             let area = 0.5 * (geo(p1) - geo(p0)).cross(geo(p2) - geo(p0)).length();
             if area <= 0.0 {
                 continue;
             }
             // Orthonormal basis of the triangle's plane in R^n (Gram–Schmidt).
-            let mut e1 = [0.0; MAX_N];
-            let mut e2 = [0.0; MAX_N];
+            let mut e1 = [0.0; N];
+            let mut e2 = [0.0; N];
             for i in 0..N {
                 e1[i] = p1[i] - p0[i];
                 e2[i] = p2[i] - p0[i];
@@ -108,7 +106,7 @@ impl AttributeQuadrics {
             if l1 <= 0.0 {
                 continue;
             }
-            e1.iter_mut().take(N).for_each(|x| *x /= l1);
+            e1.iter_mut().for_each(|x| *x /= l1);
             let d = dot(&e1, &e2);
             for i in 0..N {
                 e2[i] -= d * e1[i];
@@ -117,13 +115,15 @@ impl AttributeQuadrics {
             if l2 <= 1e-300 {
                 continue;
             }
-            e2.iter_mut().take(N).for_each(|x| *x /= l2);
+            e2.iter_mut().for_each(|x| *x /= l2);
             let (pe1, pe2) = (dot(p0, &e1), dot(p0, &e2));
-            let mut k = [0.0; STRIDE_MAX];
+            let mut k = [0.0; S];
+            let mut at = 0;
             for i in 0..N {
                 for j in i..N {
                     let id = if i == j { 1.0 } else { 0.0 };
-                    k[tri_index(N, i, j)] = area * (id - e1[i] * e1[j] - e2[i] * e2[j]);
+                    k[at] = area * (id - e1[i] * e1[j] - e2[i] * e2[j]);
+                    at += 1;
                 }
             }
             for i in 0..N {
@@ -131,8 +131,8 @@ impl AttributeQuadrics {
             }
             k[off + N] = area * (dot(p0, p0) - pe1 * pe1 - pe2 * pe2);
             for w in corners {
-                let base = w as usize * stride;
-                for (dst, src) in self.data[base..base + stride].iter_mut().zip(&k[..stride]) {
+                let base = w as usize * S;
+                for (dst, src) in self.data[base..base + S].iter_mut().zip(&k) {
                     *dst += src;
                 }
             }
@@ -144,10 +144,10 @@ impl AttributeQuadrics {
     }
 
     /// A wedge as a point of R^n in model units.
-    fn point(&self, adj: &Adjacency, w: u32) -> [f64; MAX_N] {
+    fn point<const N: usize>(&self, adj: &Adjacency, w: u32) -> [f64; N] {
         let wd = adj.wedges[w as usize];
         let p = adj.positions[wd.vertex as usize].as_dvec3();
-        let mut v = [0.0; MAX_N];
+        let mut v = [0.0; N];
         v[..3].copy_from_slice(&p.to_array());
         self.attrs_into(&wd, &mut v[3..]);
         v
@@ -189,9 +189,18 @@ impl AttributeQuadrics {
         if dst == src {
             return;
         }
-        let (d, s) = (dst as usize * self.stride, src as usize * self.stride);
-        for i in 0..self.stride {
-            self.data[d + i] += self.data[s + i];
+        let stride = self.stride;
+        let (d, s) = (dst as usize * stride, src as usize * stride);
+        // Two disjoint rows of the one array, zipped (no index checks; the adds vectorize).
+        let (dst_row, src_row) = if d < s {
+            let (lo, hi) = self.data.split_at_mut(s);
+            (&mut lo[d..d + stride], &hi[..stride])
+        } else {
+            let (lo, hi) = self.data.split_at_mut(d);
+            (&mut hi[..stride], &lo[s..s + stride])
+        };
+        for (x, y) in dst_row.iter_mut().zip(src_row.iter()) {
+            *x += y;
         }
     }
 
@@ -223,11 +232,13 @@ impl AttributeQuadrics {
     ) -> f64 {
         // One instance per dimension, so every loop below has a constant trip count and every
         // packed index is a constant (this runs for every queued edge; the instances unroll).
+        // (N, M = N − 3 and the packed size S are all given, so every scratch array has its
+        // exact size: nothing larger is cleared per call.)
         match self.n() {
-            6 => self.reduced::<6, WANT_ATTRS>(wedges, x, keep, attrs),
-            8 => self.reduced::<8, WANT_ATTRS>(wedges, x, keep, attrs),
-            9 => self.reduced::<9, WANT_ATTRS>(wedges, x, keep, attrs),
-            11 => self.reduced::<11, WANT_ATTRS>(wedges, x, keep, attrs),
+            6 => self.reduced::<6, 3, 28, WANT_ATTRS>(wedges, x, keep, attrs),
+            8 => self.reduced::<8, 5, 45, WANT_ATTRS>(wedges, x, keep, attrs),
+            9 => self.reduced::<9, 6, 55, WANT_ATTRS>(wedges, x, keep, attrs),
+            11 => self.reduced::<11, 8, 78, WANT_ATTRS>(wedges, x, keep, attrs),
             n => unreachable!("attribute quadrics of dimension {n}"),
         }
     }
@@ -239,39 +250,39 @@ impl AttributeQuadrics {
     /// the quadric there.
     // Dense linear algebra on fixed-size arrays: index loops read like the formulas.
     #[allow(clippy::needless_range_loop)]
-    fn reduced<const N: usize, const WANT_ATTRS: bool>(
+    fn reduced<const N: usize, const M: usize, const S: usize, const WANT_ATTRS: bool>(
         &self,
         wedges: &[u32],
         x: DVec3,
         keep: &Wedge,
         attrs: &mut [f64; MAX_M],
     ) -> f64 {
-        let m = N - 3;
-        let stride = N * (N + 1) / 2 + N + 1;
+        let m = M;
+        let stride = S;
+        debug_assert_eq!((M, S), (N - 3, N * (N + 1) / 2 + N + 1));
         debug_assert_eq!(stride, self.stride);
         let off = N * (N + 1) / 2;
         // Sum the wedges' packed quadrics.
-        let mut q = [0.0f64; STRIDE_MAX];
+        let mut q = [0.0f64; S];
         let quadric = |w: u32| &self.data[w as usize * stride..(w as usize + 1) * stride];
         // The first two at once (a collapse's usual group; no copy of the first on its own).
+        // (Zipped iterators: no bounds checks, so the sums vectorize.)
         let d0 = quadric(wedges[0]);
         match wedges.get(1) {
             Some(&w1) => {
-                let d1 = quadric(w1);
-                for k in 0..stride {
-                    q[k] = d0[k] + d1[k];
+                for ((s, x), y) in q.iter_mut().zip(d0).zip(quadric(w1)) {
+                    *s = x + y;
                 }
             }
             None => {
-                for k in 0..stride {
-                    q[k] = d0[k];
+                for (s, x) in q.iter_mut().zip(d0) {
+                    *s = *x;
                 }
             }
         }
         for &w in wedges.iter().skip(2) {
-            let d = quadric(w);
-            for k in 0..stride {
-                q[k] += d[k];
+            for (s, x) in q.iter_mut().zip(quadric(w)) {
+                *s += x;
             }
         }
         let at = |i: usize, j: usize| q[tri_index(N, i, j)];
@@ -286,62 +297,64 @@ impl AttributeQuadrics {
             base += xs[i] * (row + 2.0 * q[off + i]);
         }
         // r = A_ax·x + b_a.
-        let mut r = [0.0f64; MAX_M];
+        let mut r = [0.0f64; M];
         for k in 0..m {
             r[k] =
                 at(3 + k, 0) * xs[0] + at(3 + k, 1) * xs[1] + at(3 + k, 2) * xs[2] + q[off + 3 + k];
         }
-        // Cholesky of A_aa; a pivot below 1e-12 of its trace counts as singular.
-        let mut l = [[0.0f64; MAX_M]; MAX_M];
+        // A_aa = L·D·Lᵀ (unit lower L, no square roots); a pivot below 1e-12 of the trace counts
+        // as singular. Then rᵀA_aa⁻¹r = Σ zᵢ²/dᵢ with z = L⁻¹r, and a∗ = −L⁻ᵀD⁻¹z.
         let mut trace = 0.0;
         for k in 0..m {
             trace += at(3 + k, 3 + k);
         }
         let tiny = 1e-12 * trace.max(1e-300);
+        let mut l = [[0.0f64; M]; M];
+        let mut inv_d = [0.0f64; M];
         let mut ok = true;
-        'outer: for i in 0..m {
-            for j in 0..=i {
+        for i in 0..m {
+            // Row i of L·D (w = L[i][j]·d[j]) and the pivot d[i].
+            let mut w = [0.0f64; M];
+            let mut d = at(3 + i, 3 + i);
+            for j in 0..i {
                 let mut s = at(3 + i, 3 + j);
                 for k in 0..j {
-                    s -= l[i][k] * l[j][k];
+                    s -= w[k] * l[j][k];
                 }
-                if i == j {
-                    if s <= tiny {
-                        ok = false;
-                        break 'outer;
-                    }
-                    l[i][i] = s.sqrt();
-                } else {
-                    l[i][j] = s / l[j][j];
-                }
+                w[j] = s;
+                l[i][j] = s * inv_d[j];
+                d -= s * l[i][j];
             }
+            if d <= tiny {
+                ok = false;
+                break;
+            }
+            inv_d[i] = 1.0 / d;
         }
         if ok {
-            // y = L⁻¹r; the minimum is base − |y|².
-            let mut y = [0.0f64; MAX_M];
-            let mut yy = 0.0;
+            let mut z = [0.0f64; M];
+            let mut quad = 0.0;
             for i in 0..m {
                 let mut s = r[i];
                 for k in 0..i {
-                    s -= l[i][k] * y[k];
+                    s -= l[i][k] * z[k];
                 }
-                y[i] = s / l[i][i];
-                yy += y[i] * y[i];
+                z[i] = s;
+                quad += s * s * inv_d[i];
             }
             if WANT_ATTRS {
-                // a∗ = −L⁻ᵀy.
                 for i in (0..m).rev() {
-                    let mut s = y[i];
+                    let mut s = z[i] * inv_d[i];
                     for k in i + 1..m {
                         s -= l[k][i] * attrs[k];
                     }
-                    attrs[i] = s / l[i][i];
+                    attrs[i] = s;
                 }
                 for a in attrs.iter_mut().take(m) {
                     *a = -*a;
                 }
             }
-            return (base - yy).max(0.0);
+            return (base - quad).max(0.0);
         }
         // Singular: the quadric at (x, keep's attributes).
         let mut a = [0.0f64; MAX_M];

@@ -68,6 +68,7 @@ impl Quadric {
     }
 
     /// Sum of two quadrics.
+    #[inline]
     pub fn add(&self, o: &Quadric) -> Quadric {
         let mut r = *self;
         for i in 0..6 {
@@ -82,6 +83,7 @@ impl Quadric {
     }
 
     /// Q(v), the weighted sum of squared plane distances.
+    #[inline]
     pub fn eval(&self, v: DVec3) -> f64 {
         let a = &self.a;
         let q = a[0] * v.x * v.x
@@ -95,20 +97,30 @@ impl Quadric {
         q.max(0.0)
     }
 
-    /// The minimiser −A⁻¹b, if A is well conditioned.
+    /// The minimiser −A⁻¹b, if A is well conditioned (|det A| above 1e-9 of trace³).
+    #[inline]
     pub fn optimum(&self) -> Option<DVec3> {
-        let a = &self.a;
-        let m = glam::DMat3::from_cols(
-            DVec3::new(a[0], a[1], a[2]),
-            DVec3::new(a[1], a[3], a[4]),
-            DVec3::new(a[2], a[4], a[5]),
-        );
-        let det = m.determinant();
-        let scale = (a[0] + a[3] + a[5]).powi(3).max(1e-300);
+        // A is symmetric: six cofactors give the determinant and A⁻¹ = C/det.
+        let [a0, a1, a2, a3, a4, a5] = self.a;
+        let c00 = a3 * a5 - a4 * a4;
+        let c01 = a2 * a4 - a1 * a5;
+        let c02 = a1 * a4 - a2 * a3;
+        let c11 = a0 * a5 - a2 * a2;
+        let c12 = a1 * a2 - a0 * a4;
+        let c22 = a0 * a3 - a1 * a1;
+        let det = a0 * c00 + a1 * c01 + a2 * c02;
+        let trace = a0 + a3 + a5;
+        let scale = (trace * trace * trace).max(1e-300);
         if det.abs() <= 1e-9 * scale {
             return None;
         }
-        let x = m.inverse() * -DVec3::new(self.b[0], self.b[1], self.b[2]);
+        let [b0, b1, b2] = self.b;
+        let k = -1.0 / det;
+        let x = DVec3::new(
+            k * (c00 * b0 + c01 * b1 + c02 * b2),
+            k * (c01 * b0 + c11 * b1 + c12 * b2),
+            k * (c02 * b0 + c12 * b1 + c22 * b2),
+        );
         x.is_finite().then_some(x)
     }
 
@@ -127,6 +139,11 @@ impl Quadric {
 pub trait CollapseCost: Sync {
     /// Cost (lower collapses first), the new position, and the error to record (model units).
     fn evaluate(&self, adj: &Adjacency, a: u32, b: u32) -> (f64, Vec3, f64);
+    /// The cost part of [`CollapseCost::evaluate`] alone (what the queue needs); a cost whose
+    /// position or error take extra work overrides it.
+    fn cost(&self, adj: &Adjacency, a: u32, b: u32) -> f64 {
+        self.evaluate(adj, a, b).0
+    }
     /// Vertex `v` is about to be evaluated: ask for its data's cache lines, so that the misses of
     /// a collapse's whole ring of re-evaluated edges overlap. A hint only.
     fn prefetch(&self, _adj: &Adjacency, _v: u32) {}
@@ -146,8 +163,11 @@ pub trait CollapseCost: Sync {
         a: u32,
         b: u32,
         map: &[(u32, u32)],
-    ) -> Vec<(u32, Wedge)>;
+    ) -> WedgeValues;
 }
+
+/// New attribute values of wedges (most collapses change one: no allocation then).
+pub type WedgeValues = smallvec::SmallVec<[(u32, Wedge); 1]>;
 
 /// Garland–Heckbert quadrics: geometric (1997) for placement, and per-wedge attribute quadrics
 /// (1998, `attributes.rs`) for the attribute values and their share of the cost.
@@ -226,18 +246,21 @@ impl QemCost {
     }
 
     /// The geometric part: the quadric of the merged vertex and where it goes.
+    #[inline(always)]
     fn place(&self, adj: &Adjacency, a: u32, b: u32) -> (Quadric, DVec3) {
         let q = self.quadrics[a as usize].add(&self.quadrics[b as usize]);
         let (pa, pb) = (
             adj.positions[a as usize].as_dvec3(),
             adj.positions[b as usize].as_dvec3(),
         );
-        // b stays put when it may not move; otherwise the optimum or the best fallback.
+        // b stays put when it may not move; otherwise the optimum (if it lies within twice the
+        // edge's length of the edge's midpoint) or the best fallback.
         let p = if adj.is_locked(b) {
             pb
         } else {
+            let reach = 2.0 * (pa - pb).length() + 1e-12;
             match q.optimum() {
-                Some(x) if (x - 0.5 * (pa + pb)).length() <= 2.0 * (pa - pb).length() + 1e-12 => x,
+                Some(x) if (x - 0.5 * (pa + pb)).length_squared() <= reach * reach => x,
                 _ => [pa, pb, 0.5 * (pa + pb)]
                     .into_iter()
                     .min_by(|x, y| q.eval(*x).total_cmp(&q.eval(*y)))
@@ -248,12 +271,13 @@ impl QemCost {
     }
 }
 
-impl CollapseCost for QemCost {
-    fn evaluate(&self, adj: &Adjacency, a: u32, b: u32) -> (f64, Vec3, f64) {
+impl QemCost {
+    /// The cost of collapsing `a` into `b` and where the merged vertex goes, with its quadric.
+    fn cost_at(&self, adj: &Adjacency, a: u32, b: u32) -> (f64, DVec3, Quadric) {
         let (q, p) = self.place(adj, a, b);
         let mut cost = q.eval(p);
         let Some(attrs) = &self.attributes else {
-            return (cost, p.as_vec3(), q.rms(p));
+            return (cost, p, q);
         };
         if let Some((wa, wb)) = adj.single_wedges(a, b) {
             // The common case, one wedge each: the one group `for_groups` would make, without
@@ -264,7 +288,18 @@ impl CollapseCost for QemCost {
                 cost += attrs.cost(group, p, &adj.wedges[wb as usize]);
             });
         }
+        (cost, p, q)
+    }
+}
+
+impl CollapseCost for QemCost {
+    fn evaluate(&self, adj: &Adjacency, a: u32, b: u32) -> (f64, Vec3, f64) {
+        let (cost, p, q) = self.cost_at(adj, a, b);
         (cost, p.as_vec3(), q.rms(p))
+    }
+
+    fn cost(&self, adj: &Adjacency, a: u32, b: u32) -> f64 {
+        self.cost_at(adj, a, b).0
     }
 
     fn prefetch(&self, adj: &Adjacency, v: u32) {
@@ -289,12 +324,12 @@ impl CollapseCost for QemCost {
         a: u32,
         b: u32,
         map: &[(u32, u32)],
-    ) -> Vec<(u32, Wedge)> {
+    ) -> WedgeValues {
         self.quadrics[b as usize] = self.quadrics[b as usize].add(&self.quadrics[a as usize]);
         let Some(attrs) = &mut self.attributes else {
-            return Vec::new();
+            return WedgeValues::new();
         };
-        let mut changes = Vec::new();
+        let mut changes = WedgeValues::new();
         let x = adj.positions[b as usize].as_dvec3();
         Self::for_groups(adj, b, map, |wb, group| {
             let (w, _) = attrs.optimal(group, x, &adj.wedges[wb as usize]);
@@ -333,7 +368,7 @@ pub struct Collapse {
     /// Triangles after it.
     pub triangles: usize,
     /// New attribute values of the surviving wedges.
-    pub attributes: Vec<(u32, Wedge)>,
+    pub attributes: WedgeValues,
 }
 
 /// The start mesh and the collapse sequence: any prefix is a LOD.
@@ -385,12 +420,16 @@ impl Progressive {
     }
 }
 
-/// Queue entry, ordered by cost, then the vertex ids: the smallest pops first. 20 bytes (the queue
-/// holds millions of them on large meshes).
+/// Queue entry, ordered by cost, then the vertex ids (then the stamp): the smallest pops first.
+///
+/// 16 bytes, so a node's four children fill one cache line of the 4-ary queue, which holds
+/// millions of entries on large meshes and whose pops are mostly cache misses. The cost is
+/// rounded to f32 for this (a relative step of 6e-8): collapses whose costs agree to seven
+/// digits are ordered by their vertex ids.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
 struct Entry {
-    /// High and low halves of the cost's bits (a non-negative f64 orders like its bits).
-    cost: [u32; 2],
+    /// The cost's bits as f32 (a non-negative float orders like its bits).
+    cost: u32,
     a: u32,
     b: u32,
     /// version[a] + version[b] when queued. Versions only grow, so the sum is unchanged exactly
@@ -403,6 +442,9 @@ impl Entry {
         version[self.a as usize].wrapping_add(version[self.b as usize]) == self.stamp
     }
 }
+
+/// Vertices per task when the first costs are evaluated in parallel.
+const INITIAL_CHUNK: u32 = 512;
 
 /// Run the edge-collapse engine on `adj` with `cost` until `stop`.
 pub fn run(adj: Adjacency, cost: &mut dyn CollapseCost, stop: Stop, diagonal: f64) -> Progressive {
@@ -419,10 +461,8 @@ pub fn run(adj: Adjacency, cost: &mut dyn CollapseCost, stop: Stop, diagonal: f6
         if adj.is_locked(a) {
             return None;
         }
-        let (c, _, _) = cost.evaluate(adj, a, b);
-        let bits = c.max(0.0).to_bits();
         Some(Entry {
-            cost: [(bits >> 32) as u32, bits as u32],
+            cost: (cost.cost(adj, a, b).max(0.0) as f32).to_bits(),
             a,
             b,
             stamp: version[a as usize].wrapping_add(version[b as usize]),
@@ -431,12 +471,21 @@ pub fn run(adj: Adjacency, cost: &mut dyn CollapseCost, stop: Stop, diagonal: f6
     // The first costs of all edges are independent: evaluated in parallel, then heapified in one
     // go. Entries are totally ordered (cost, then vertex ids), so the pop order — and the result
     // — does not depend on the thread count.
+    // Each vertex costs its edges to higher vertices (each edge once), in chunks of vertices.
     let initial: Vec<Entry> = {
         let (adj, cost, version) = (&adj, &*cost, &version);
-        adj.edges()
-            .par_iter()
-            .with_min_len(1024)
-            .filter_map(|&(u, v)| entry(adj, cost, version, u, v))
+        let vertices = adj.positions.len() as u32;
+        (0..vertices.div_ceil(INITIAL_CHUNK))
+            .into_par_iter()
+            .flat_map_iter(|c| {
+                let range = c * INITIAL_CHUNK..((c + 1) * INITIAL_CHUNK).min(vertices);
+                range.flat_map(move |u| {
+                    adj.ring(u)
+                        .into_iter()
+                        .filter(move |&v| v > u)
+                        .filter_map(move |v| entry(adj, cost, version, u, v))
+                })
+            })
             .collect()
     };
     let mut heap = MinQueue::from_vec(initial);
@@ -446,6 +495,7 @@ pub fn run(adj: Adjacency, cost: &mut dyn CollapseCost, stop: Stop, diagonal: f6
         Stop::Triangles(_) => f64::INFINITY,
     };
     let mut rebuild_at = heap.len().max(1024) * 5 / 4;
+    let mut ring = Local::new();
     while let Some(e) = heap.pop() {
         if let Stop::Triangles(n) = stop
             && adj.triangle_count() <= n
@@ -490,10 +540,10 @@ pub fn run(adj: Adjacency, cost: &mut dyn CollapseCost, stop: Stop, diagonal: f6
             continue;
         }
         // A refused collapse changes nothing, so each direction is checked and applied in one go.
-        let (from, to, map) = match adj.collapse_for_good(a, b, p) {
+        let (from, to, map) = match adj.collapse_for_good(a, b, p, &mut ring) {
             Ok(map) => (a, b, map),
             Err(_) if !adj.is_locked(b) && adj.class(b) <= adj.class(a) => {
-                match adj.collapse_for_good(b, a, p) {
+                match adj.collapse_for_good(b, a, p, &mut ring) {
                     Ok(map) => (b, a, map),
                     Err(_) => continue,
                 }
@@ -513,11 +563,10 @@ pub fn run(adj: Adjacency, cost: &mut dyn CollapseCost, stop: Stop, diagonal: f6
         });
         // Only the edges around `to` changed (its quadric and position); their old entries
         // carry `to`'s old version and are skipped when popped.
-        let ring = adj.ring(to);
         for &n in &ring {
             cost.prefetch(&adj, n);
         }
-        for n in ring {
+        for &n in &ring {
             if let Some(e) = entry(&adj, cost, &version, to, n) {
                 heap.push(e);
             }

@@ -43,6 +43,7 @@ impl<T: Ord + Copy> MinQueue<T> {
     }
 
     /// Remove and return the smallest entry.
+    #[inline(never)]
     pub fn pop(&mut self) -> Option<T> {
         let last = self.items.pop()?;
         if self.items.is_empty() {
