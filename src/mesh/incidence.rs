@@ -224,7 +224,10 @@ impl Incidence {
 
     /// Drop the items of `drop` from `v`'s list, then merge the ascending `items` into it.
     pub fn retain_merge(&mut self, v: u32, drop: &[u32], items: &[u32]) {
-        let (s, l) = (self.start[v as usize] as usize, self.len[v as usize] as usize);
+        let (s, l) = (
+            self.start[v as usize] as usize,
+            self.len[v as usize] as usize,
+        );
         let list = &mut self.data[s..s + l];
         let mut kept = 0;
         for i in 0..l {

@@ -30,7 +30,7 @@ use glam::{DVec3, Vec3};
 use rayon::prelude::*;
 
 use super::attributes::AttributeQuadrics;
-use super::queue::MinQueue;
+use super::queue::{Keyed, RadixQueue};
 use crate::error::Result;
 use crate::mesh::Mesh;
 use crate::mesh::adjacency::{Adjacency, Local, VertexClass, Wedge};
@@ -157,13 +157,8 @@ pub trait CollapseCost: Sync {
     /// `a` was collapsed into `b` (already applied to `adj`; `map` pairs each wedge of `a` with
     /// the wedge of `b` it merged into). The cost may set new wedge attributes in `adj`; it
     /// returns them so the progressive record can replay them.
-    fn collapsed(
-        &mut self,
-        adj: &mut Adjacency,
-        a: u32,
-        b: u32,
-        map: &[(u32, u32)],
-    ) -> WedgeValues;
+    fn collapsed(&mut self, adj: &mut Adjacency, a: u32, b: u32, map: &[(u32, u32)])
+    -> WedgeValues;
 }
 
 /// New attribute values of wedges (most collapses change one: no allocation then).
@@ -443,6 +438,17 @@ impl Entry {
     }
 }
 
+impl Keyed for Entry {
+    #[inline]
+    fn key(&self) -> u32 {
+        self.cost
+    }
+    #[inline]
+    fn raise_key(&mut self, k: u32) {
+        self.cost = self.cost.max(k);
+    }
+}
+
 /// Vertices per task when the first costs are evaluated in parallel.
 const INITIAL_CHUNK: u32 = 512;
 
@@ -488,15 +494,17 @@ pub fn run(adj: Adjacency, cost: &mut dyn CollapseCost, stop: Stop, diagonal: f6
             })
             .collect()
     };
-    let mut heap = MinQueue::from_vec(initial);
+    let mut heap = RadixQueue::from_vec(initial);
     let mut collapses = Vec::new();
     let limit = match stop {
         Stop::RelativeError(e) => e * diagonal,
         Stop::Triangles(_) => f64::INFINITY,
     };
-    let mut rebuild_at = heap.len().max(1024) * 5 / 4;
     let mut ring = Local::new();
-    while let Some(e) = heap.pop() {
+    // Every collapse leaves the old entries of the edges around the kept vertex behind (their
+    // stamps no longer match); the queue drops them when it sorts their bucket, or they pop and
+    // are skipped here.
+    while let Some(e) = heap.pop(|e| e.current(&version)) {
         if let Stop::Triangles(n) = stop
             && adj.triangle_count() <= n
         {
@@ -506,19 +514,6 @@ pub fn run(adj: Adjacency, cost: &mut dyn CollapseCost, stop: Stop, diagonal: f6
             continue;
         }
         let (a, b) = (e.a, e.b);
-        // Every collapse leaves the old entries of the edges around the kept vertex behind. When
-        // the heap has grown by a quarter since it last held only current entries, the stale
-        // ones are dropped in one linear pass instead of being popped one by one (each pop is a
-        // walk down a heap too large for the caches). Waiting for the heap to double, as this
-        // did first, never purged at all: pops shrink the heap as fast as pushes grow it, and
-        // 90 % of pops were stale (bunny at 10 %: 266 000 of 298 000; now 37 000 of 69 000,
-        // with 14 purges). A purge follows at least a quarter of its size in pushes, so it costs
-        // O(1) per push amortised. The current entries keep their order, so the collapse
-        // sequence is the same.
-        if heap.len() > rebuild_at {
-            heap.retain(|e| e.current(&version));
-            rebuild_at = heap.len().max(1024) * 5 / 4;
-        }
         let (p, err) = cost.placement(&adj, a, b);
         if err > limit {
             break;
