@@ -504,12 +504,22 @@ impl Adjacency {
 
     /// Live triangles containing both `a` and `b`.
     pub fn edge_triangles(&self, a: u32, b: u32) -> Local<u32> {
+        let mut shared = Local::new();
+        for &t in self.vtris.get(a) {
+            if self.tris[t as usize].contains(&b) {
+                shared.push(t);
+            }
+        }
+        shared
+    }
+
+    /// How many live triangles contain both `a` and `b`.
+    pub fn edge_triangle_count(&self, a: u32, b: u32) -> usize {
         self.vtris
             .get(a)
             .iter()
-            .copied()
-            .filter(|&t| self.tris[t as usize].contains(&b))
-            .collect()
+            .filter(|&&t| self.tris[t as usize].contains(&b))
+            .count()
     }
 
     /// Every live edge (a < b), ascending.
@@ -785,13 +795,12 @@ impl Adjacency {
         }
         // a's other triangles (ascending) move to b: merged into b's ascending list, which
         // drops the dead ones.
-        let moved: Local<u32> = self
-            .vtris
-            .get(a)
-            .iter()
-            .copied()
-            .filter(|t| !shared.contains(t))
-            .collect();
+        let mut moved: Local<u32> = Local::new();
+        for &t in self.vtris.get(a) {
+            if !shared.contains(&t) {
+                moved.push(t);
+            }
+        }
         self.vtris.clear(a);
         for &t in &moved {
             let k = self.tris[t as usize].iter().position(|&x| x == a).unwrap();

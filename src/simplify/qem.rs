@@ -30,7 +30,7 @@ use glam::{DVec3, Vec3};
 use rayon::prelude::*;
 
 use super::attributes::AttributeQuadrics;
-use super::queue::{Keyed, RadixQueue};
+use super::queue::{Keyed, Lookahead};
 use crate::error::Result;
 use crate::mesh::Mesh;
 use crate::mesh::adjacency::{Adjacency, Local, VertexClass, Wedge};
@@ -449,6 +449,10 @@ impl Keyed for Entry {
     }
 }
 
+/// Queue entries popped ahead of their turn, so their vertices' data is fetched while earlier
+/// collapses are made.
+const LOOKAHEAD: usize = 4;
+
 /// Vertices per task when the first costs are evaluated in parallel.
 const INITIAL_CHUNK: u32 = 512;
 
@@ -494,7 +498,7 @@ pub fn run(adj: Adjacency, cost: &mut dyn CollapseCost, stop: Stop, diagonal: f6
             })
             .collect()
     };
-    let mut heap = RadixQueue::from_vec(initial);
+    let mut heap = Lookahead::new(initial, LOOKAHEAD);
     let mut collapses = Vec::new();
     let limit = match stop {
         Stop::RelativeError(e) => e * diagonal,
@@ -504,7 +508,15 @@ pub fn run(adj: Adjacency, cost: &mut dyn CollapseCost, stop: Stop, diagonal: f6
     // Every collapse leaves the old entries of the edges around the kept vertex behind (their
     // stamps no longer match); the queue drops them when it sorts their bucket, or they pop and
     // are skipped here.
-    while let Some(e) = heap.pop(|e| e.current(&version)) {
+    while let Some(e) = heap.pop(
+        |e| e.current(&version),
+        |e| {
+            for v in [e.a, e.b] {
+                cost.prefetch(&adj, v);
+                adj.prefetch_triangles(v);
+            }
+        },
+    ) {
         if let Stop::Triangles(n) = stop
             && adj.triangle_count() <= n
         {
@@ -523,7 +535,7 @@ pub fn run(adj: Adjacency, cost: &mut dyn CollapseCost, stop: Stop, diagonal: f6
         // with no replay from the start. (A refused collapse does not end the prefix, so it is
         // only checked.)
         if let Stop::Triangles(n) = stop
-            && adj.triangle_count() - adj.edge_triangles(a, b).len().min(adj.triangle_count()) < n
+            && adj.triangle_count() - adj.edge_triangle_count(a, b).min(adj.triangle_count()) < n
         {
             let legal = adj.can_collapse(a, b, p).is_ok()
                 || (!adj.is_locked(b)

@@ -103,6 +103,74 @@ impl<T: Keyed + Ord + Copy> RadixQueue<T> {
     }
 }
 
+/// A [`RadixQueue`] that pops a few entries ahead of time, so that the caller can ask for their
+/// data's cache lines while it works on the current one (the engine's collapses are spread over
+/// the whole mesh, so each one starts with cache misses).
+///
+/// Entries pushed below the last key taken from the radix queue wait in a small heap of their
+/// own, so every entry comes out in key order (entries with equal keys in the order they reach
+/// the front).
+#[derive(Debug, Clone)]
+pub(crate) struct Lookahead<T> {
+    queue: RadixQueue<T>,
+    early: MinQueue<T>,
+    ahead: std::collections::VecDeque<T>,
+    depth: usize,
+}
+
+impl<T: Keyed + Ord + Copy> Lookahead<T> {
+    /// A queue of `items` that keeps `depth` entries popped ahead.
+    pub fn new(items: Vec<T>, depth: usize) -> Lookahead<T> {
+        Lookahead {
+            queue: RadixQueue::from_vec(items),
+            early: MinQueue { items: Vec::new() },
+            ahead: std::collections::VecDeque::with_capacity(depth),
+            depth,
+        }
+    }
+
+    /// Add an entry.
+    #[inline]
+    pub fn push(&mut self, x: T) {
+        if x.key() < self.queue.last {
+            self.early.push(x);
+        } else {
+            self.queue.push(x);
+        }
+    }
+
+    /// Remove and return the least entry for which `keep` holds (others may be dropped on the
+    /// way). Entries newly popped ahead are handed to `fetch` first.
+    pub fn pop(&mut self, keep: impl Fn(&T) -> bool, mut fetch: impl FnMut(&T)) -> Option<T> {
+        while self.ahead.len() < self.depth {
+            match self.queue.pop(&keep) {
+                Some(x) => {
+                    fetch(&x);
+                    self.ahead.push_back(x);
+                }
+                None => break,
+            }
+        }
+        loop {
+            let take_early = match (self.early.peek(), self.ahead.front()) {
+                (Some(e), Some(a)) => e < a,
+                (Some(_), None) => true,
+                (None, Some(_)) => false,
+                (None, None) => return None,
+            };
+            let x = if take_early {
+                self.early.pop()
+            } else {
+                self.ahead.pop_front()
+            };
+            match x {
+                Some(x) if keep(&x) => return Some(x),
+                _ => {}
+            }
+        }
+    }
+}
+
 /// Children per node.
 const D: usize = 4;
 
@@ -123,6 +191,11 @@ impl<T: Ord + Copy> MinQueue<T> {
     pub fn push(&mut self, x: T) {
         self.items.push(x);
         self.sift_up(self.items.len() - 1);
+    }
+
+    /// The smallest entry.
+    pub fn peek(&self) -> Option<&T> {
+        self.items.first()
     }
 
     /// Remove and return the smallest entry.
