@@ -543,6 +543,7 @@ pub fn run(adj: Adjacency, cost: &mut dyn CollapseCost, stop: Stop, diagonal: f6
         // with no replay from the start. (A refused collapse does not end the prefix, so it is
         // only checked.)
         if let Stop::Triangles(n) = stop
+            && adj.triangle_count() < n + adj.vertex_triangles(a).len()
             && adj.triangle_count() - adj.edge_triangle_count(a, b).min(adj.triangle_count()) < n
         {
             let legal = adj.can_collapse(a, b, p).is_ok()
