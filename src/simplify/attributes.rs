@@ -9,8 +9,10 @@
 //!
 //! Placement: the position comes from the geometric quadric (`qem.rs`); given that position, each
 //! surviving wedge's attributes are the minimiser of its summed quadric, a ∗ = −A_aa⁻¹(A_ax·x + b_a)
-//! (an m×m Cholesky solve), and the collapse costs the sum of the wedges' quadrics at (x, a∗).
-//! Where A_aa is singular (too few faces) the wedge keeps its attributes.
+//! (an m×m LDLᵀ solve), and the collapse costs the sum of the wedges' quadrics at (x, a∗), which is
+//! the Schur complement xᵀA_xx·x + 2·b_x·x + c − rᵀA_aa⁻¹r with r = A_ax·x + b_a (a queued edge
+//! needs only that value, so no attributes are formed for it). Where A_aa is singular (too few
+//! faces) the wedge keeps its attributes.
 //!
 //! Units. Attributes are scaled into model units before they enter the quadric, so that an
 //! attribute error costs like a displacement. For a mesh with bounding-box diagonal D:
@@ -208,7 +210,7 @@ impl AttributeQuadrics {
     /// starting from `keep` where the system is singular) and the quadric's value there.
     pub fn optimal(&self, wedges: &[u32], x: DVec3, keep: &Wedge) -> (Wedge, f64) {
         let mut attrs = [0.0; MAX_M];
-        let value = self.solve(wedges, x, keep, &mut attrs);
+        let value = self.solve_n::<true>(wedges, x, keep, &mut attrs);
         (self.wedge_from(&attrs, keep), value)
     }
 
@@ -217,12 +219,8 @@ impl AttributeQuadrics {
         self.solve_n::<false>(wedges, x, keep, &mut [0.0; MAX_M])
     }
 
-    /// The quadric's minimum over the attributes at position `x` (the attributes into `attrs`
-    /// when `WANT_ATTRS`).
-    fn solve(&self, wedges: &[u32], x: DVec3, keep: &Wedge, attrs: &mut [f64; MAX_M]) -> f64 {
-        self.solve_n::<true>(wedges, x, keep, attrs)
-    }
-
+    /// The summed quadric's minimum over the attributes at position `x` (the attributes into
+    /// `attrs` when `WANT_ATTRS`).
     fn solve_n<const WANT_ATTRS: bool>(
         &self,
         wedges: &[u32],
@@ -244,10 +242,10 @@ impl AttributeQuadrics {
     }
 
     /// The summed quadric's minimum over the attributes with the position held at `x`, by the
-    /// Schur complement: with r = A_ax·x + b_a and A_aa = L·Lᵀ (Cholesky),
-    /// min over a of Q(x, a) = xᵀA_xx·x + 2·b_x·x + c − |L⁻¹r|², at a∗ = −L⁻ᵀ(L⁻¹r).
-    /// Where A_aa is singular (too few faces) the attributes stay at `keep`'s and the value is
-    /// the quadric there.
+    /// Schur complement: with r = A_ax·x + b_a and A_aa = L·D·Lᵀ (L unit lower triangular),
+    /// min over a of Q(x, a) = xᵀA_xx·x + 2·b_x·x + c − rᵀA_aa⁻¹r, at a∗ = −A_aa⁻¹r. Where A_aa
+    /// is singular (a pivot below 1e-12 of its trace: too few faces) the attributes stay at
+    /// `keep`'s and the value is the quadric there.
     // Dense linear algebra on fixed-size arrays: index loops read like the formulas.
     #[allow(clippy::needless_range_loop)]
     fn reduced<const N: usize, const M: usize, const S: usize, const WANT_ATTRS: bool>(
