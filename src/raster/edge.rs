@@ -28,10 +28,6 @@ pub(crate) struct TileSamples {
     pub ids: Vec<u32>,
     /// Coverage counts per sample (diagnostic mode only: every covering triangle counts, no depth test).
     pub counts: Option<Vec<u16>>,
-    /// Break depth ties by the lower id instead of by drawing order. With ids that increase in
-    /// drawing order this gives the same result in any order (the incremental luminance images
-    /// rasterize a region's triangles in whatever order they find them).
-    pub lowest_id_wins_ties: bool,
 }
 
 /// Marker for an uncovered sample.
@@ -46,20 +42,7 @@ impl TileSamples {
             depth: vec![f32::INFINITY; n],
             ids: vec![EMPTY; n],
             counts: count_coverage.then(|| vec![0; n]),
-            lowest_id_wins_ties: false,
         }
-    }
-}
-
-impl TileSamples {
-    /// Size the buffers for `rect` (no coverage counting) without clearing them: for a caller
-    /// that writes every sample before rasterizing.
-    pub fn resize_for(&mut self, rect: [i32; 4]) {
-        let n = ((rect[2] - rect[0]) * (rect[3] - rect[1])) as usize * self.samples;
-        self.rect = rect;
-        self.depth.resize(n, f32::INFINITY);
-        self.ids.resize(n, EMPTY);
-        self.counts = None;
     }
 }
 
@@ -82,22 +65,7 @@ pub(crate) fn rasterize(
     if x0 >= x1 || y0 >= y1 {
         return;
     }
-    let one = super::fixed::ONE_PIXEL;
-    let p = st.v.map(|q| [q[0] as i64, q[1] as i64]);
-    // Edge i: from p[i+1] to p[i+2]; E = a_x·(x − ax) + b_y·(y − ay) with a_x = −d.y, b_y = d.x.
-    let mut coef = [[0i64; 2]; 3];
-    let mut origin = [0i64; 3];
-    let mut bias = [0i64; 3];
-    for i in 0..3 {
-        let a = p[(i + 1) % 3];
-        let b = p[(i + 2) % 3];
-        let (dx, dy) = (b[0] - a[0], b[1] - a[1]);
-        coef[i] = [-dy, dx];
-        // Value at the corner of pixel (x0, y0).
-        origin[i] = -dy * (x0 as i64 * one - a[0]) + dx * (y0 as i64 * one - a[1]);
-        let top_left = (dy == 0 && dx > 0) || dy < 0;
-        bias[i] = if top_left { 0 } else { -1 };
-    }
+    let Edges { origin, coef, bias } = edges_at(st, x0, y0);
     let s = offsets.len();
     let rect = [x0, y0, x1, y1];
     if s == 1 && buf.counts.is_none() {
@@ -136,6 +104,74 @@ pub(crate) fn rasterize(
         (_, false) => scan::<0, false>(st, id, rect, &edges, sample_off, buf),
         (_, true) => scan::<0, true>(st, id, rect, &edges, sample_off, buf),
     }
+}
+
+/// Call `f(x, y, depth)` for every pixel of `clip` whose centre `st` covers: one sample at the
+/// pixel centre, with the same coverage and depth as [`rasterize`] with that one offset (for a
+/// caller that keeps its own per-pixel state, such as the luminance images' two layers).
+pub(crate) fn rasterize_each(st: &SetupTri, clip: [i32; 4], mut f: impl FnMut(i32, i32, f32)) {
+    let bbox = st.bbox();
+    let (x0, y0) = (bbox[0].max(clip[0]), bbox[1].max(clip[1]));
+    let (x1, y1) = (bbox[2].min(clip[2]), bbox[3].min(clip[3]));
+    if x0 >= x1 || y0 >= y1 {
+        return;
+    }
+    let Edges {
+        mut origin,
+        coef,
+        bias,
+    } = edges_at(st, x0, y0);
+    let half = super::fixed::ONE_PIXEL / 2;
+    let off = sample_offset(&coef, &bias, [half, half]);
+    for i in 0..3 {
+        origin[i] += off[i];
+    }
+    let one = super::fixed::ONE_PIXEL;
+    let step_x = coef.map(|c| c[0] * one);
+    let step_y = coef.map(|c| c[1] * one);
+    // 1/area on the first covered sample, as the one-sample scan does.
+    let mut inv_area = 0.0f64;
+    let mut row = origin;
+    for y in y0..y1 {
+        let mut e = row;
+        for x in x0..x1 {
+            if (e[0] | e[1] | e[2]) >= 0 {
+                if inv_area == 0.0 {
+                    inv_area = 1.0 / st.area() as f64;
+                }
+                let w = [0, 1, 2].map(|i| (e[i] - bias[i]) as f64);
+                f(x, y, interpolated_depth(st, w, inv_area));
+            }
+            for i in 0..3 {
+                e[i] += step_x[i];
+            }
+        }
+        for i in 0..3 {
+            row[i] += step_y[i];
+        }
+    }
+}
+
+/// The edge functions of `st` at the corner of pixel (x0, y0), their x and y coefficients and the
+/// top-left bias.
+fn edges_at(st: &SetupTri, x0: i32, y0: i32) -> Edges {
+    let one = super::fixed::ONE_PIXEL;
+    let p = st.v.map(|q| [q[0] as i64, q[1] as i64]);
+    // Edge i: from p[i+1] to p[i+2]; E = a_x·(x − ax) + b_y·(y − ay) with a_x = −d.y, b_y = d.x.
+    let mut coef = [[0i64; 2]; 3];
+    let mut origin = [0i64; 3];
+    let mut bias = [0i64; 3];
+    for i in 0..3 {
+        let a = p[(i + 1) % 3];
+        let b = p[(i + 2) % 3];
+        let (dx, dy) = (b[0] - a[0], b[1] - a[1]);
+        coef[i] = [-dy, dx];
+        // Value at the corner of pixel (x0, y0).
+        origin[i] = -dy * (x0 as i64 * one - a[0]) + dx * (y0 as i64 * one - a[1]);
+        let top_left = (dy == 0 && dx > 0) || dy < 0;
+        bias[i] = if top_left { 0 } else { -1 };
+    }
+    Edges { origin, coef, bias }
 }
 
 /// How much each edge value at sample offset `o` (Fx24_8, within the pixel) exceeds the value at
@@ -216,12 +252,11 @@ fn interpolated_depth(st: &SetupTri, w: [f64; 3], inv_area: f64) -> f32 {
     ((w[0] * z[0] + w[1] * z[1] + w[2] * z[2]) * inv_area) as f32
 }
 
-/// Keep `depth` and `id` at sample `slot` if nearer (or, where `lowest_id_wins_ties`, as near and
-/// with a lower id).
+/// Keep `depth` and `id` at sample `slot` if nearer (ties go to the triangle drawn first).
 #[inline(always)]
 fn depth_test(buf: &mut TileSamples, slot: usize, id: u32, depth: f32) {
     let d = buf.depth[slot];
-    if depth < d || (buf.lowest_id_wins_ties && depth == d && id < buf.ids[slot]) {
+    if depth < d {
         buf.depth[slot] = depth;
         buf.ids[slot] = id;
     }
