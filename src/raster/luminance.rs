@@ -215,6 +215,58 @@ struct View {
     /// Unique in the process: names the scratch contents with the trial serial.
     id: u64,
     trial: Trial,
+    /// Counts commits (the fills below hold for one committed state).
+    commits: u64,
+    /// The last trial's holes and re-shaded pixels with their fills.
+    fills: Fills,
+}
+
+/// The pixels a trial must visit whatever the new positions are, the holes and the re-shaded
+/// pixels, with what fills them: they depend only on which triangles changed and on the committed
+/// state, and the downhill simplex tries one vertex set dozens of times in a row, so a view keeps
+/// the last trial's and reuses them while both stay the same.
+#[derive(Debug, Default)]
+struct Fills {
+    valid: bool,
+    /// The view's commit count they were made at.
+    commits: u64,
+    changed: Vec<u32>,
+    reshaded: Vec<u32>,
+    touched: Vec<Touch>,
+}
+
+impl Fills {
+    /// Whether they were made for these changed and re-shaded triangles at this commit count.
+    fn hold_for(
+        &self,
+        commits: u64,
+        changed: &[(u32, Option<[i32; 4]>)],
+        reshaded: &[u32],
+    ) -> bool {
+        self.valid
+            && self.commits == commits
+            && self.changed.len() == changed.len()
+            && self.changed.iter().zip(changed).all(|(a, b)| *a == b.0)
+            && self.reshaded == reshaded
+    }
+
+    /// Keep `touched` as the fills of these changed and re-shaded triangles.
+    fn keep(
+        &mut self,
+        commits: u64,
+        changed: &[(u32, Option<[i32; 4]>)],
+        reshaded: &[u32],
+        touched: &[Touch],
+    ) {
+        self.valid = true;
+        self.commits = commits;
+        self.changed.clear();
+        self.changed.extend(changed.iter().map(|c| c.0));
+        self.reshaded.clear();
+        self.reshaded.extend_from_slice(reshaded);
+        self.touched.clear();
+        self.touched.extend_from_slice(touched);
+    }
 }
 
 /// A triangle in a bucket, with its box (so the triangles that miss a rectangle are passed over
@@ -343,7 +395,6 @@ struct Scratch {
     /// The view id and trial serial whose render the buffers hold.
     owner: Option<(u64, u32)>,
 }
-
 
 thread_local! {
     static SCRATCH: std::cell::RefCell<Scratch> = std::cell::RefCell::new(Scratch::default());
@@ -541,6 +592,8 @@ impl LumaViews {
                     tile_far: vec![f32::INFINITY; n_tiles],
                     id: NEXT_VIEW_ID.fetch_add(1, std::sync::atomic::Ordering::Relaxed),
                     trial: Trial::default(),
+                    commits: 0,
+                    fills: Fills::default(),
                 }
             })
             .collect();
@@ -981,107 +1034,118 @@ impl View {
         } = scratch;
         touched.clear();
         let changed_piece = |id: u32| id != EMPTY && stamp[(id >> PIECE_BITS) as usize] == number;
-        // 1. Holes, the pixels a changed triangle showed (the second layer shows there now),
-        //    and the pixels of re-shaded triangles (their pieces stay, their shading changes):
-        //    found in the old boxes of those that show anywhere, visited once each. One pass over
-        //    the boxes' union where that is smaller than the boxes together (they overlap around
-        //    a moved vertex), else box by box.
-        let mut deep: Option<[i32; 4]> = None;
-        let (mut union_box, mut box_area) = (None, 0i64);
-        let showing = changed
-            .iter()
-            .map(|&(t, _)| t)
-            .chain(reshaded_shown.iter().copied())
-            .filter(|&t| shows(&self.shown_count, t))
-            .filter_map(|t| *self.bbox.get(t as usize)?);
-        for b in showing.clone() {
-            union_box = Some(union(union_box, b));
-            box_area += ((b[2] - b[0]) * (b[3] - b[1])) as i64;
-        }
-        let mut visit = |p: usize, x: i32, y: i32| {
-            let c = &self.px[p];
-            if c.shown == EMPTY || mark[p] == number {
-                return;
+        if self.fills.hold_for(self.commits, changed, reshaded_shown) {
+            // The same triangles changed as in the last trial, on the same committed state.
+            touched.extend_from_slice(&self.fills.touched);
+            for (i, e) in touched.iter().enumerate() {
+                mark[e.p as usize] = number;
+                slot[e.p as usize] = i as u32;
             }
-            let s = stamp[(c.shown >> PIECE_BITS) as usize];
-            let touch = if s == number {
-                let [second, third] = self.second[p];
-                let second = if changed_piece(second.shown) {
-                    third
-                } else {
-                    second
-                };
-                if changed_piece(second.shown) {
-                    deep = Some(union(deep, [x, y, x + 1, y + 1]));
-                    Touch {
-                        p: p as u32,
-                        id: EMPTY,
-                        depth: f32::INFINITY,
-                        deep: true,
+        } else {
+            // 1. Holes, the pixels a changed triangle showed (the second layer shows there now),
+            //    and the pixels of re-shaded triangles (their pieces stay, their shading changes):
+            //    found in the old boxes of those that show anywhere, visited once each. One pass over
+            //    the boxes' union where that is smaller than the boxes together (they overlap around
+            //    a moved vertex), else box by box.
+            let mut deep: Option<[i32; 4]> = None;
+            let (mut union_box, mut box_area) = (None, 0i64);
+            let showing = changed
+                .iter()
+                .map(|&(t, _)| t)
+                .chain(reshaded_shown.iter().copied())
+                .filter(|&t| shows(&self.shown_count, t))
+                .filter_map(|t| *self.bbox.get(t as usize)?);
+            for b in showing.clone() {
+                union_box = Some(union(union_box, b));
+                box_area += ((b[2] - b[0]) * (b[3] - b[1])) as i64;
+            }
+            let mut visit = |p: usize, x: i32, y: i32| {
+                let c = &self.px[p];
+                if c.shown == EMPTY || mark[p] == number {
+                    return;
+                }
+                let s = stamp[(c.shown >> PIECE_BITS) as usize];
+                let touch = if s == number {
+                    let [second, third] = self.second[p];
+                    let second = if changed_piece(second.shown) {
+                        third
+                    } else {
+                        second
+                    };
+                    if changed_piece(second.shown) {
+                        deep = Some(union(deep, [x, y, x + 1, y + 1]));
+                        Touch {
+                            p: p as u32,
+                            id: EMPTY,
+                            depth: f32::INFINITY,
+                            deep: true,
+                        }
+                    } else {
+                        Touch {
+                            p: p as u32,
+                            id: second.shown,
+                            depth: second.depth,
+                            deep: false,
+                        }
                     }
-                } else {
+                } else if s == reshade {
                     Touch {
                         p: p as u32,
-                        id: second.shown,
-                        depth: second.depth,
+                        id: c.shown,
+                        depth: c.depth,
                         deep: false,
                     }
-                }
-            } else if s == reshade {
-                Touch {
-                    p: p as u32,
-                    id: c.shown,
-                    depth: c.depth,
-                    deep: false,
-                }
-            } else {
-                return;
+                } else {
+                    return;
+                };
+                mark[p] = number;
+                slot[p] = touched.len() as u32;
+                touched.push(touch);
             };
-            mark[p] = number;
-            slot[p] = touched.len() as u32;
-            touched.push(touch);
-        };
-        let mut scan = |b: [i32; 4]| {
-            for y in b[1]..b[3] {
-                let row = y as usize * w;
-                for x in b[0]..b[2] {
-                    visit(row + x as usize, x, y);
+            let mut scan = |b: [i32; 4]| {
+                for y in b[1]..b[3] {
+                    let row = y as usize * w;
+                    for x in b[0]..b[2] {
+                        visit(row + x as usize, x, y);
+                    }
                 }
+            };
+            match union_box {
+                Some(u) if ((u[2] - u[0]) * (u[3] - u[1])) as i64 <= box_area => scan(u),
+                _ => showing.for_each(scan),
             }
-        };
-        match union_box {
-            Some(u) if ((u[2] - u[0]) * (u[3] - u[1])) as i64 <= box_area => scan(u),
-            _ => showing.for_each(scan),
-        }
-        // Holes three changed layers deep (a fold, a silhouette): the unchanged triangles there,
-        // through the buckets, each once.
-        if let Some(h) = deep {
-            #[cfg(test)]
-            tests::DEEP_RENDERS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-            candidates.clear();
-            for tile in tiles(self.tiles_x, h) {
-                for entry in &self.buckets[tile] {
-                    let tu = entry.tri as usize;
-                    if entry.overlaps(h) && stamp[tu] != number && visited[tu] != number {
-                        visited[tu] = number;
-                        candidates.push(entry.tri);
+            // Holes three changed layers deep (a fold, a silhouette): the unchanged triangles there,
+            // through the buckets, each once.
+            if let Some(h) = deep {
+                #[cfg(test)]
+                tests::DEEP_RENDERS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+                candidates.clear();
+                for tile in tiles(self.tiles_x, h) {
+                    for entry in &self.buckets[tile] {
+                        let tu = entry.tri as usize;
+                        if entry.overlaps(h) && stamp[tu] != number && visited[tu] != number {
+                            visited[tu] = number;
+                            candidates.push(entry.tri);
+                        }
+                    }
+                }
+                for &t in candidates.iter() {
+                    for (k, p) in self.pieces[t as usize].iter().enumerate() {
+                        let id = (t << PIECE_BITS) | k as u32;
+                        edge::rasterize_each(&p.st, h, |x, y, depth| {
+                            let at = y as usize * w + x as usize;
+                            if mark[at] == number {
+                                let e = &mut touched[slot[at] as usize];
+                                if e.deep && nearer(depth, id, e.depth, e.id) {
+                                    (e.depth, e.id) = (depth, id);
+                                }
+                            }
+                        });
                     }
                 }
             }
-            for &t in candidates.iter() {
-                for (k, p) in self.pieces[t as usize].iter().enumerate() {
-                    let id = (t << PIECE_BITS) | k as u32;
-                    edge::rasterize_each(&p.st, h, |x, y, depth| {
-                        let at = y as usize * w + x as usize;
-                        if mark[at] == number {
-                            let e = &mut touched[slot[at] as usize];
-                            if e.deep && nearer(depth, id, e.depth, e.id) {
-                                (e.depth, e.id) = (depth, id);
-                            }
-                        }
-                    });
-                }
-            }
+            self.fills
+                .keep(self.commits, changed, reshaded_shown, touched);
         }
         // 2. The changed triangles' new pieces. Where nothing that changed shows, no hole
         //    opened, so a piece behind every committed depth of its tiles changes nothing.
@@ -1256,6 +1320,7 @@ impl View {
         if let Some(rect) = region {
             self.render_layers(shared, mesh, rect, scratch);
         }
+        self.commits += 1;
         self.trial.saved_xf.clear();
         self.trial.saved_light.clear();
         // What the scratch holds is committed now, not a pending trial.
@@ -1557,9 +1622,11 @@ mod tests {
     #[test]
     fn random_moves_keep_the_layers_and_images_of_a_fresh_render() {
         // Vertex moves large enough to fold the surface over itself (holes several changed layers
-        // deep) and normal changes (re-shaded triangles), each accepted or reverted at random:
-        // the incremental state equals a fresh render of the final mesh, all three layers of
-        // every pixel included, and the accepted ΔE add up to its energy exactly.
+        // deep) and normal changes (re-shaded triangles), each tried a few times in a row with
+        // other values (as the simplex does: the views reuse their holes' fills) and then
+        // accepted or reverted at random: the incremental state equals a fresh render of the
+        // final mesh, all three layers of every pixel included, and the accepted ΔE add up to its
+        // energy exactly.
         let original = Arc::new(shapes::icosphere(3));
         let scene = Scene::new(original.clone());
         let cams = cameras(&original, 5);
@@ -1581,33 +1648,42 @@ mod tests {
         let unit = |r: u64| (r % 2001) as f32 / 1000.0 - 1.0;
         let deep_before = DEEP_RENDERS.load(std::sync::atomic::Ordering::Relaxed);
         let mut accepted = 0;
+        let mut v = 0;
         for _ in 0..80 {
-            let v = (next() % adj.positions.len() as u64) as u32;
+            // Now and then the same vertex again, after an accept too (the fills must not
+            // outlive the committed state they were made on).
+            if next() % 3 != 0 {
+                v = (next() % adj.positions.len() as u64) as u32;
+            }
             let tris: Vec<u32> = adj.vertex_triangles(v).to_vec();
             let w0 = adj.single_wedge(v).unwrap();
             let (old_p, old_n) = (adj.positions[v as usize], adj.wedges[w0 as usize].normal);
-            let delta = if next() % 3 == 0 {
-                // A new normal: the same corners, new shading.
-                let n = Vec3::new(unit(next()), unit(next()), unit(next()));
-                adj.wedges[w0 as usize].normal = (n + old_n).normalize_or(old_n);
-                let change = Change {
-                    vertices: &[],
-                    wedges: &[w0],
-                    triangles: &[],
-                    reshaded: &tris,
+            let normal = next() % 3 == 0;
+            let mut delta = 0;
+            for _ in 0..1 + next() % 3 {
+                delta = if normal {
+                    // A new normal: the same corners, new shading.
+                    let n = Vec3::new(unit(next()), unit(next()), unit(next()));
+                    adj.wedges[w0 as usize].normal = (n + old_n).normalize_or(old_n);
+                    let change = Change {
+                        vertices: &[],
+                        wedges: &[w0],
+                        triangles: &[],
+                        reshaded: &tris,
+                    };
+                    views.trial(&adj, &change)
+                } else {
+                    let d = Vec3::new(unit(next()), unit(next()), unit(next()));
+                    adj.positions[v as usize] = old_p + 0.6 * d;
+                    let change = Change {
+                        vertices: &[v],
+                        wedges: &[],
+                        triangles: &tris,
+                        reshaded: &[],
+                    };
+                    views.trial(&adj, &change)
                 };
-                views.trial(&adj, &change)
-            } else {
-                let d = Vec3::new(unit(next()), unit(next()), unit(next()));
-                adj.positions[v as usize] = old_p + 0.6 * d;
-                let change = Change {
-                    vertices: &[v],
-                    wedges: &[],
-                    triangles: &tris,
-                    reshaded: &[],
-                };
-                views.trial(&adj, &change)
-            };
+            }
             if next() % 2 == 0 {
                 views.commit(&adj);
                 energy += delta;
