@@ -61,6 +61,7 @@ use rayon::prelude::*;
 use smallvec::SmallVec;
 
 use super::clip::ClipPlanes;
+use super::crew::Crew;
 use super::edge::{self, EMPTY};
 use super::setup::{SetupOut, SetupTri, Viewport, XfVertex, setup_one, transform_one};
 use super::shade::{ResolvedLight, light_terms, source_barycentrics};
@@ -435,6 +436,41 @@ pub struct LumaViews {
     /// The pending trial's changed and re-shaded triangles (for a commit; the same in every view).
     pending_triangles: Vec<u32>,
     pending_reshaded: Vec<u32>,
+    /// Runs the views of a trial (made at the first trial, as many threads as rayon's pool).
+    crew: Option<Crew>,
+}
+
+/// Run `f` on every view, spread over `crew` (made at the first call, with as many threads as
+/// rayon's pool has, but no more than the machine has cores). Trials come thousands of times a
+/// second, and the crew stays awake between them (rayon's workers would sleep and be woken for
+/// each).
+fn each_view(crew: &mut Option<Crew>, views: &mut [View], f: &(dyn Fn(&mut View) + Sync)) {
+    let crew = crew.get_or_insert_with(|| {
+        let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
+        Crew::new(rayon::current_num_threads().min(cores))
+    });
+    let ptr = ViewsPtr(views.as_mut_ptr());
+    crew.run(views.len(), &|i| {
+        // SAFETY: `i < views.len()`, the crew calls each index once (so the views borrowed are
+        // disjoint), and `run` returns only when every call has.
+        f(unsafe { &mut *ptr.at(i) })
+    });
+}
+
+/// The views of a [`LumaViews`], lent to the crew: each call takes the view of its own index.
+#[derive(Clone, Copy)]
+struct ViewsPtr(*mut View);
+
+// SAFETY: a `View` is `Send`, and every index is handed to one call only (see `LumaViews::trial`).
+unsafe impl Sync for ViewsPtr {}
+unsafe impl Send for ViewsPtr {}
+
+impl ViewsPtr {
+    /// View `i` (in bounds by the caller).
+    fn at(self, i: usize) -> *mut View {
+        // SAFETY: in bounds, as the caller promises.
+        unsafe { self.0.add(i) }
+    }
 }
 
 /// sRGB encoding of a linear value in [0, 1].
@@ -626,7 +662,34 @@ impl LumaViews {
             pending: false,
             pending_triangles: Vec::new(),
             pending_reshaded: Vec::new(),
+            crew: None,
         })
+    }
+
+    /// The luminance images of `mesh` from `cameras`, as [`LumaViews::new`] then
+    /// [`LumaViews::images`] make them (the same codes), holding one view's state per thread
+    /// instead of every view's (a dense original's pieces take tens of MB per view).
+    pub fn images_of(
+        mesh: &Adjacency,
+        scene: &Scene,
+        cameras: &[Camera],
+        width: u32,
+        height: u32,
+    ) -> Result<Vec<Vec<u16>>> {
+        cameras
+            .par_iter()
+            .map(|camera| {
+                let one = LumaViews::new(
+                    mesh,
+                    scene,
+                    std::slice::from_ref(camera),
+                    width,
+                    height,
+                    None,
+                )?;
+                Ok(one.images().swap_remove(0))
+            })
+            .collect()
     }
 
     /// Number of views.
@@ -700,12 +763,20 @@ impl LumaViews {
         self.pending_triangles.extend_from_slice(change.triangles);
         self.pending_reshaded.clear();
         self.pending_reshaded.extend_from_slice(change.reshaded);
-        let shared = &self.shared;
-        let wm = &self.wedge_material;
-        self.views
-            .par_iter_mut()
-            .map(|v| with_scratch(|s| v.trial(shared, mesh, wm, change, false, s)))
-            .sum()
+        let LumaViews {
+            shared,
+            views,
+            wedge_material: wm,
+            crew,
+            ..
+        } = self;
+        let total = std::sync::atomic::AtomicI64::new(0);
+        each_view(crew, views, &|v| {
+            let d = with_scratch(|s| v.trial(shared, mesh, wm, change, false, s));
+            total.fetch_add(d, std::sync::atomic::Ordering::Relaxed);
+        });
+        // Integer sums: the same total in any order, so for any thread count.
+        total.into_inner()
     }
 
     /// Make the pending trial the committed state; `mesh` must be the mesh of the trial.
@@ -720,9 +791,9 @@ impl LumaViews {
             triangles: &self.pending_triangles,
             reshaded: &self.pending_reshaded,
         };
-        self.views
-            .par_iter_mut()
-            .for_each(|v| with_scratch(|s| v.commit(shared, mesh, &change, s)));
+        each_view(&mut self.crew, &mut self.views, &|v| {
+            with_scratch(|s| v.commit(shared, mesh, &change, s));
+        });
     }
 
     /// Drop the pending trial.
@@ -1278,7 +1349,15 @@ impl View {
         if everything {
             region = Some([0, 0, shared.width as i32, shared.height as i32]);
         }
-        // Pieces and buckets of the changed triangles.
+        // Pieces and buckets of the changed triangles (all of them, the first time: room for
+        // all at once, not grown one by one).
+        if everything {
+            let slots = mesh.triangle_slots();
+            self.pieces
+                .reserve_exact(slots.saturating_sub(self.pieces.len()));
+            self.bbox
+                .reserve_exact(slots.saturating_sub(self.bbox.len()));
+        }
         let mut k = 0;
         for &(t, bb) in &scratch.bbox {
             let t_us = t as usize;
@@ -1585,6 +1664,23 @@ mod tests {
         eprintln!("{differ} of {shaded} shaded pixels ({total} in all) one code apart");
         assert!(shaded > total / 10);
         assert!(differ * 100 <= shaded, "{differ} of {shaded} pixels differ");
+    }
+
+    #[test]
+    fn images_view_by_view_equal_the_images_of_all_views() {
+        // `images_of` (one view's state per thread) gives every view's codes as a LumaViews of
+        // all views does.
+        let mesh = Arc::new(shapes::icosphere(3));
+        let scene = Scene::new(mesh.clone());
+        let cams = cameras(&mesh, 5);
+        let adj = Adjacency::new(&mesh);
+        let all = LumaViews::new(&adj, &scene, &cams, 40, 30, None)
+            .unwrap()
+            .images();
+        let one_by_one = LumaViews::images_of(&adj, &scene, &cams, 40, 30).unwrap();
+        assert_eq!(all.len(), 5);
+        assert!(all.iter().all(|im| im.iter().any(|&y| y != all[0][0])));
+        assert_eq!(one_by_one, all);
     }
 
     #[test]

@@ -21,6 +21,7 @@
 
 mod bin;
 mod clip;
+mod crew;
 mod edge;
 mod fixed;
 mod frame;

@@ -158,7 +158,7 @@ pub fn cameras(original: &Mesh, rig: &Rig) -> Vec<Camera> {
 pub fn target_images(original: &Arc<Mesh>, cameras: &[Camera], size: u32) -> Result<Vec<Vec<u16>>> {
     let scene = Scene::new(original.clone());
     let adj = Adjacency::new(original);
-    Ok(LumaViews::new(&adj, &scene, cameras, size, size, None)?.images())
+    LumaViews::images_of(&adj, &scene, cameras, size, size)
 }
 
 /// d_MS (eq. 1) of `mesh` against target images from `cameras`.
