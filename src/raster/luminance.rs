@@ -1630,12 +1630,17 @@ mod tests {
             .collect()
     }
 
+    /// A level-3 icosphere's scene, `n` cameras around it and its adjacency.
+    fn icosphere_views(n: u32) -> (Scene, Vec<Camera>, Adjacency) {
+        let mesh = Arc::new(shapes::icosphere(3));
+        let cams = cameras(&mesh, n);
+        let adj = Adjacency::new(&mesh);
+        (Scene::new(mesh), cams, adj)
+    }
+
     #[test]
     fn full_render_equals_the_rasterizer_at_one_sample() {
-        let mesh = Arc::new(shapes::icosphere(3));
-        let scene = Scene::new(mesh.clone());
-        let cams = cameras(&mesh, 3);
-        let adj = Adjacency::new(&mesh);
+        let (scene, cams, adj) = icosphere_views(3);
         let views = LumaViews::new(&adj, &scene, &cams, 64, 48, None).unwrap();
         let settings = RenderSettings {
             width: 64,
@@ -1670,10 +1675,7 @@ mod tests {
     fn images_view_by_view_equal_the_images_of_all_views() {
         // `images_of` (one view's state per thread) gives every view's codes as a LumaViews of
         // all views does.
-        let mesh = Arc::new(shapes::icosphere(3));
-        let scene = Scene::new(mesh.clone());
-        let cams = cameras(&mesh, 5);
-        let adj = Adjacency::new(&mesh);
+        let (scene, cams, adj) = icosphere_views(5);
         let all = LumaViews::new(&adj, &scene, &cams, 40, 30, None)
             .unwrap()
             .images();
