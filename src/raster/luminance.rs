@@ -461,9 +461,14 @@ fn each_view(crew: &mut Option<Crew>, views: &mut [View], f: &(dyn Fn(&mut View)
 #[derive(Clone, Copy)]
 struct ViewsPtr(*mut View);
 
-// SAFETY: a `View` is `Send`, and every index is handed to one call only (see `LumaViews::trial`).
+// SAFETY: a `View` is `Send` (checked below), and every index is handed to one call only (see
+// `each_view`), so no view is reached from two threads at once.
 unsafe impl Sync for ViewsPtr {}
 unsafe impl Send for ViewsPtr {}
+const _: () = {
+    const fn send<T: Send>() {}
+    send::<View>();
+};
 
 impl ViewsPtr {
     /// View `i` (in bounds by the caller).
