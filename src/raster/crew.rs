@@ -32,9 +32,8 @@ struct Job {
 unsafe impl Send for Job {}
 
 struct Inner {
-    /// Bumped (under `job`'s lock) when a job is published.
-    epoch: AtomicU64,
-    /// (epoch << 32) | next index to claim.
+    /// (epoch << 32) | next index to claim. The epoch (the job's number) is bumped under `job`'s
+    /// lock when a job is published; workers watch it for the next job.
     claim: AtomicU64,
     /// Calls of the current job that have returned.
     done: AtomicUsize,
@@ -63,7 +62,6 @@ impl Crew {
     /// up the others.)
     pub fn new(threads: usize) -> Crew {
         let inner = Arc::new(Inner {
-            epoch: AtomicU64::new(0),
             claim: AtomicU64::new(0),
             done: AtomicUsize::new(0),
             job: Mutex::new(None),
@@ -94,24 +92,20 @@ impl Crew {
         // a call needs an index claimed under this job's epoch, and we return only when all `n`
         // claimed calls have returned (`done == n`); later claims of this epoch find `n` taken.
         let f: *const (dyn Fn(usize) + Sync + 'static) = unsafe { std::mem::transmute(f) };
-        let epoch = {
-            let mut job = inner.job.lock().expect("crew lock");
-            let epoch = (inner.epoch.load(Ordering::Relaxed) + 1) as u32;
-            inner.done.store(0, Ordering::Relaxed);
-            inner.claim.store((epoch as u64) << 32, Ordering::Release);
-            *job = Some(Job {
-                epoch,
+        let job = {
+            let mut slot = inner.job.lock().expect("crew lock");
+            let job = Job {
+                epoch: epoch_of(inner.claim.load(Ordering::Relaxed)).wrapping_add(1),
                 n: n as u32,
                 f,
-            });
-            inner.epoch.store(epoch as u64, Ordering::Release);
+            };
+            inner.done.store(0, Ordering::Relaxed);
+            *slot = Some(job);
+            inner
+                .claim
+                .store((job.epoch as u64) << 32, Ordering::Release);
             inner.wake.notify_all();
-            epoch
-        };
-        let job = Job {
-            epoch,
-            n: n as u32,
-            f,
+            job
         };
         take_part(inner, job);
         while inner.done.load(Ordering::Acquire) < n {
@@ -140,7 +134,7 @@ impl Drop for Crew {
 fn take_part(inner: &Inner, job: Job) {
     let mut c = inner.claim.load(Ordering::Acquire);
     loop {
-        if (c >> 32) as u32 != job.epoch || (c as u32) >= job.n {
+        if epoch_of(c) != job.epoch || (c as u32) >= job.n {
             return;
         }
         match inner
@@ -162,12 +156,20 @@ fn take_part(inner: &Inner, job: Job) {
     }
 }
 
+/// The epoch part of a claim word.
+fn epoch_of(claim: u64) -> u32 {
+    (claim >> 32) as u32
+}
+
 /// A worker's life: spin for the next job, sleep when none comes for a while.
 fn work(inner: &Inner) {
-    let mut seen = 0u64;
+    let mut seen = 0u32;
+    let waiting = |seen: u32| {
+        epoch_of(inner.claim.load(Ordering::Acquire)) == seen && !inner.stop.load(Ordering::Acquire)
+    };
     loop {
         let (mut spins, start) = (0u32, std::time::Instant::now());
-        while inner.epoch.load(Ordering::Acquire) == seen && !inner.stop.load(Ordering::Acquire) {
+        while waiting(seen) {
             spins = spins.wrapping_add(1);
             if spins % 64 != 0 || start.elapsed() < SPIN {
                 std::hint::spin_loop();
@@ -176,10 +178,7 @@ fn work(inner: &Inner) {
             let job = inner.job.lock().expect("crew lock");
             let _job = inner
                 .wake
-                .wait_while(job, |_| {
-                    inner.epoch.load(Ordering::Acquire) == seen
-                        && !inner.stop.load(Ordering::Acquire)
-                })
+                .wait_while(job, |_| waiting(seen))
                 .expect("crew lock");
             break;
         }
@@ -191,7 +190,7 @@ fn work(inner: &Inner) {
             .lock()
             .expect("crew lock")
             .expect("a published job");
-        seen = job.epoch as u64;
+        seen = job.epoch;
         take_part(inner, job);
     }
 }
