@@ -597,7 +597,7 @@ pub fn run(adj: Adjacency, cost: &mut dyn CollapseCost, stop: Stop, diagonal: f6
 
 /// The progressive record of `mesh` down to `stop`, with attribute-aware quadrics.
 pub fn progressive(mesh: &Mesh, stop: Stop) -> Progressive {
-    let mut adj = Adjacency::new(mesh);
+    let mut adj = Adjacency::new_spatial(mesh);
     adj.allow_non_manifold_collapses();
     let diagonal = mesh.aabb().diagonal() as f64;
     let mut cost = QemCost::with_attributes(&adj, diagonal);
