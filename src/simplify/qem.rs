@@ -13,7 +13,9 @@
 //!   dropped when the queue spreads their bucket); ties are broken by vertex ids, so the collapse
 //!   sequence is deterministic. A few entries are popped ahead of their turn so their vertices'
 //!   data is fetched while the collapses before them are made (each collapse starts with cache
-//!   misses: the cheapest edge can be anywhere on the mesh).
+//!   misses: the cheapest edge can be anywhere on the mesh). The adjacency numbers vertices
+//!   along a Morton curve ([`Adjacency::new_spatial`]), so an edge's neighbours sit close
+//!   together in every per-vertex and per-wedge array.
 //! - The work per collapse is what the engine's speed is: the edges around the kept vertex are
 //!   costed again (a 3×3 solve for the place and a Schur complement for the attributes, about 9
 //!   edges), the link condition and the fold test read the two fans once (the adjacency marks
