@@ -492,21 +492,30 @@ pub fn run(adj: Adjacency, cost: &mut dyn CollapseCost, stop: Stop, diagonal: f6
     // go. Entries are totally ordered (cost, then vertex ids), so the pop order — and the result
     // — does not depend on the thread count.
     // Each vertex costs its edges to higher vertices (each edge once), in chunks of vertices.
+    // (Each chunk fills its own vector, and the chunks are joined in order: a flattened
+    // parallel iterator spent a third as much again as the costs on its bookkeeping.)
     let initial: Vec<Entry> = {
         let (adj, cost, version) = (&adj, &*cost, &version);
         let vertices = adj.positions.len() as u32;
-        (0..vertices.div_ceil(INITIAL_CHUNK))
+        let chunks: Vec<Vec<Entry>> = (0..vertices.div_ceil(INITIAL_CHUNK))
             .into_par_iter()
-            .flat_map_iter(|c| {
+            .map(|c| {
                 let range = c * INITIAL_CHUNK..((c + 1) * INITIAL_CHUNK).min(vertices);
-                range.flat_map(move |u| {
-                    adj.ring(u)
-                        .into_iter()
-                        .filter(move |&v| v > u)
-                        .filter_map(move |v| entry(adj, cost, version, u, v))
-                })
+                // About three edges per vertex start at the lower end.
+                let mut out = Vec::with_capacity(4 * range.len());
+                for u in range {
+                    for v in adj.ring(u) {
+                        if v > u
+                            && let Some(e) = entry(adj, cost, version, u, v)
+                        {
+                            out.push(e);
+                        }
+                    }
+                }
+                out
             })
-            .collect()
+            .collect();
+        chunks.concat()
     };
     let mut heap = Lookahead::new(initial, LOOKAHEAD);
     let mut collapses = Vec::new();
