@@ -372,9 +372,9 @@ struct Scratch {
     /// Re-shaded triangles that show now.
     reshaded_shown: Vec<u32>,
     setup: SetupOut,
-    /// Per image pixel: the render number that touched it, and its entry in `touched`.
-    mark: Vec<u32>,
-    slot: Vec<u32>,
+    /// Per image pixel: the render number that touched it, and its entry in `touched` (one
+    /// record, so a pixel's check and its entry share a cache line).
+    pixel: Vec<[u32; 2]>,
     /// The pixels the render may change, with their nearest pieces.
     touched: Vec<Touch>,
     /// A commit's region: the three nearest (depth, piece) per pixel.
@@ -496,8 +496,14 @@ fn luma_index(c: Vec3) -> usize {
 }
 
 /// Index of linear luminance `y` on a 16-bit scale (clamped; NaN gives 0).
+#[inline(always)]
 fn index_of_linear(y: f32) -> usize {
-    (y.clamp(0.0, 1.0) * 65535.0 + 0.5) as usize
+    // `max` returns the other operand for NaN, so the value is a number in [0.5, 65535.5]
+    // here and the plain truncating conversion applies (`as` would add the saturation and
+    // NaN checks of a general float-to-int cast: this runs for every shaded pixel).
+    let v = y.max(0.0).min(1.0) * 65535.0 + 0.5;
+    // SAFETY: v is finite and within u32's range, as above.
+    (unsafe { v.to_int_unchecked::<u32>() }) as usize
 }
 
 /// The displayed (sRGB-encoded) 16-bit code of linear luminance index `i`.
@@ -865,9 +871,8 @@ fn tiles(tiles_x: u32, r: [i32; 4]) -> impl Iterator<Item = usize> {
 impl Scratch {
     /// Size the per-pixel marks for an image of `n` pixels.
     fn pixels_for(&mut self, n: usize) {
-        if self.mark.len() < n {
-            self.mark.resize(n, 0);
-            self.slot.resize(n, 0);
+        if self.pixel.len() < n {
+            self.pixel.resize(n, [0, 0]);
         }
     }
 
@@ -885,7 +890,7 @@ impl Scratch {
             self.stamp.iter_mut().for_each(|s| *s = 0);
             self.visited.iter_mut().for_each(|s| *s = 0);
             self.reshade_at.iter_mut().for_each(|s| *s = 0);
-            self.mark.iter_mut().for_each(|s| *s = 0);
+            self.pixel.iter_mut().for_each(|s| s[0] = 0);
             self.number = 1;
         }
         self.owner = None;
@@ -1103,8 +1108,7 @@ impl View {
             reshade_at,
             candidates,
             reshading,
-            mark,
-            slot,
+            pixel,
             touched,
             ..
         } = scratch;
@@ -1114,8 +1118,7 @@ impl View {
             // The same triangles changed as in the last trial, on the same committed state.
             touched.extend_from_slice(&self.fills.touched);
             for (i, e) in touched.iter().enumerate() {
-                mark[e.p as usize] = number;
-                slot[e.p as usize] = i as u32;
+                pixel[e.p as usize] = [number, i as u32];
             }
         } else {
             // 1. Holes, the pixels a changed triangle showed (the second layer shows there now),
@@ -1137,7 +1140,7 @@ impl View {
             }
             let mut visit = |p: usize, x: i32, y: i32| {
                 let c = &self.px[p];
-                if c.shown == EMPTY || mark[p] == number {
+                if c.shown == EMPTY || pixel[p][0] == number {
                     return;
                 }
                 let s = stamp[(c.shown >> PIECE_BITS) as usize];
@@ -1174,8 +1177,7 @@ impl View {
                 } else {
                     return;
                 };
-                mark[p] = number;
-                slot[p] = touched.len() as u32;
+                pixel[p] = [number, touched.len() as u32];
                 touched.push(touch);
             };
             let mut scan = |b: [i32; 4]| {
@@ -1210,8 +1212,8 @@ impl View {
                         let id = (t << PIECE_BITS) | k as u32;
                         edge::rasterize_each(&p.st, h, |x, y, depth| {
                             let at = y as usize * w + x as usize;
-                            if mark[at] == number {
-                                let e = &mut touched[slot[at] as usize];
+                            if pixel[at][0] == number {
+                                let e = &mut touched[pixel[at][1] as usize];
                                 if e.deep && nearer(depth, id, e.depth, e.id) {
                                     (e.depth, e.id) = (depth, id);
                                 }
@@ -1233,8 +1235,8 @@ impl View {
             let id = (t << PIECE_BITS) | (k as u32 - first_piece[*t as usize]);
             edge::rasterize_each(&p.st, full, |x, y, depth| {
                 let at = y as usize * w + x as usize;
-                if mark[at] == number {
-                    let e = &mut touched[slot[at] as usize];
+                if pixel[at][0] == number {
+                    let e = &mut touched[pixel[at][1] as usize];
                     if nearer(depth, id, e.depth, e.id) {
                         (e.depth, e.id) = (depth, id);
                     }
@@ -1242,8 +1244,7 @@ impl View {
                     // Not a hole: the committed piece is unchanged and competes.
                     let c = &self.px[at];
                     if nearer(depth, id, c.depth, c.shown) {
-                        mark[at] = number;
-                        slot[at] = touched.len() as u32;
+                        pixel[at] = [number, touched.len() as u32];
                         touched.push(Touch {
                             p: at as u32,
                             id,
