@@ -134,13 +134,18 @@ pub(crate) fn rasterize_each(st: &SetupTri, clip: [i32; 4], mut f: impl FnMut(i3
     let mut row = origin;
     for y in y0..y1 {
         let mut e = row;
+        // A triangle covers one run of each row (it is convex): the row ends where the run does.
+        let mut inside = false;
         for x in x0..x1 {
             if (e[0] | e[1] | e[2]) >= 0 {
+                inside = true;
                 if inv_area == 0.0 {
                     inv_area = 1.0 / st.area() as f64;
                 }
                 let w = [0, 1, 2].map(|i| (e[i] - bias[i]) as f64);
                 f(x, y, interpolated_depth(st, w, inv_area));
+            } else if inside {
+                break;
             }
             for i in 0..3 {
                 e[i] += step_x[i];
