@@ -838,6 +838,12 @@ fn prefetch_rect<T>(px: &[T], w: usize, [x0, y0, x1, y1]: [i32; 4]) {
     }
 }
 
+/// Pixels in rectangle `r` (`[x0, y0, x1, y1)`).
+#[inline]
+fn area(r: [i32; 4]) -> i64 {
+    (r[2] - r[0]) as i64 * (r[3] - r[1]) as i64
+}
+
 /// Whether pixel rectangles `a` and `b` (`[x0, y0, x1, y1)`) share a pixel.
 #[inline]
 fn overlap(a: [i32; 4], b: [i32; 4]) -> bool {
@@ -1010,16 +1016,51 @@ impl View {
         // old box, when it shows at all) and those a new piece covers.
         let mut rect: Option<[i32; 4]> = None;
         let mut shows_now = false;
+        let mut box_area = 0i64;
+        let old_box = |t: u32| {
+            self.bbox
+                .get(t as usize)
+                .copied()
+                .flatten()
+                .filter(|_| shows(&self.shown_count, t))
+        };
         for &t in change.triangles {
             scratch.stamp[t as usize] = number;
-            if let Some(Some(b)) = self.bbox.get(t as usize)
-                && shows(&self.shown_count, t)
-            {
-                rect = Some(union(rect, *b));
+            if let Some(b) = old_box(t) {
+                rect = Some(union(rect, b));
+                box_area += area(b);
                 shows_now = true;
-                // Its pixels are read first thing in the render: ask now, while set-up runs.
-                prefetch_rect(&self.px, shared.width as usize, *b);
             }
+        }
+        // Triangles that only need shading anew (their wedges changed, not their corners).
+        for &t in change.reshaded {
+            let tu = t as usize;
+            if scratch.stamp[tu] != number && scratch.stamp[tu] != reshade {
+                scratch.stamp[tu] = reshade;
+                if let Some(b) = old_box(t) {
+                    rect = Some(union(rect, b));
+                    box_area += area(b);
+                    shows_now = true;
+                    scratch.reshaded_shown.push(t);
+                }
+            }
+        }
+        // The old boxes' pixels are read first thing in the render: ask for them now, while
+        // the set-up below runs. The boxes overlap around a moved vertex, so their union is
+        // asked for once where it is no larger than the boxes together.
+        let w = shared.width as usize;
+        match rect {
+            Some(u) if area(u) <= box_area => prefetch_rect(&self.px, w, u),
+            Some(_) => {
+                let showing = change.triangles.iter().copied().filter_map(old_box);
+                let reshaded = scratch.reshaded_shown.iter().copied().filter_map(old_box);
+                showing
+                    .chain(reshaded)
+                    .for_each(|b| prefetch_rect(&self.px, w, b));
+            }
+            None => {}
+        }
+        for &t in change.triangles {
             let mut bb: Option<[i32; 4]> = None;
             if mesh.is_alive(t) {
                 let setup = &mut scratch.setup;
@@ -1040,21 +1081,6 @@ impl View {
                 }
             }
             scratch.bbox.push((t, bb));
-        }
-        // Triangles that only need shading anew (their wedges changed, not their corners).
-        for &t in change.reshaded {
-            let tu = t as usize;
-            if scratch.stamp[tu] != number && scratch.stamp[tu] != reshade {
-                scratch.stamp[tu] = reshade;
-                if let Some(&Some(b)) = self.bbox.get(tu)
-                    && shows(&self.shown_count, t)
-                {
-                    rect = Some(union(rect, b));
-                    shows_now = true;
-                    scratch.reshaded_shown.push(t);
-                    prefetch_rect(&self.px, shared.width as usize, b);
-                }
-            }
         }
         // Where nothing that changed shows now, the committed depths stay, and a new piece
         // behind all of them in every tile it touches (the far side of a closed mesh) cannot
@@ -1136,7 +1162,7 @@ impl View {
                 .filter_map(|t| *self.bbox.get(t as usize)?);
             for b in showing.clone() {
                 union_box = Some(union(union_box, b));
-                box_area += ((b[2] - b[0]) * (b[3] - b[1])) as i64;
+                box_area += area(b);
             }
             let mut visit = |p: usize, x: i32, y: i32| {
                 let c = &self.px[p];
@@ -1189,7 +1215,7 @@ impl View {
                 }
             };
             match union_box {
-                Some(u) if ((u[2] - u[0]) * (u[3] - u[1])) as i64 <= box_area => scan(u),
+                Some(u) if area(u) <= box_area => scan(u),
                 _ => showing.for_each(scan),
             }
             // Holes three changed layers deep (a fold, a silhouette): the unchanged triangles there,
