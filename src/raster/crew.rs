@@ -42,6 +42,9 @@ struct Inner {
     stop: AtomicBool,
     /// A call panicked on a worker (the caller panics in turn once the job is done).
     panicked: AtomicBool,
+    /// Workers asleep on `wake` (or about to be): a job is announced to them only then, since
+    /// a notification costs a system call even when nobody waits.
+    sleepers: AtomicUsize,
 }
 
 /// Worker threads for [`Crew::run`] (none for a crew of one: the caller does everything).
@@ -68,6 +71,7 @@ impl Crew {
             wake: Condvar::new(),
             stop: AtomicBool::new(false),
             panicked: AtomicBool::new(false),
+            sleepers: AtomicUsize::new(0),
         });
         let workers = (1..threads.max(1))
             .map(|k| {
@@ -92,21 +96,25 @@ impl Crew {
         // a call needs an index claimed under this job's epoch, and we return only when all `n`
         // claimed calls have returned (`done == n`); later claims of this epoch find `n` taken.
         let f: *const (dyn Fn(usize) + Sync + 'static) = unsafe { std::mem::transmute(f) };
-        let job = {
-            let mut slot = inner.job.lock().expect("crew lock");
-            let job = Job {
-                epoch: epoch_of(inner.claim.load(Ordering::Relaxed)).wrapping_add(1),
-                n: n as u32,
-                f,
-            };
-            inner.done.store(0, Ordering::Relaxed);
-            *slot = Some(job);
-            inner
-                .claim
-                .store((job.epoch as u64) << 32, Ordering::Release);
-            inner.wake.notify_all();
-            job
+        let job = Job {
+            epoch: epoch_of(inner.claim.load(Ordering::Relaxed)).wrapping_add(1),
+            n: n as u32,
+            f,
         };
+        // The job is in place before its epoch shows, and the lock is free by then: a
+        // spinning worker that sees the epoch takes the lock without waiting for it.
+        *inner.job.lock().expect("crew lock") = Some(job);
+        inner.done.store(0, Ordering::Relaxed);
+        inner
+            .claim
+            .store((job.epoch as u64) << 32, Ordering::SeqCst);
+        // A worker counts itself asleep before it looks at the epoch a last time (both
+        // sequentially consistent): either it sees this epoch and stays up, or it is counted
+        // here, and the notification under the lock reaches it once it waits.
+        if inner.sleepers.load(Ordering::SeqCst) > 0 {
+            let _job = inner.job.lock().expect("crew lock");
+            inner.wake.notify_all();
+        }
         take_part(inner, job);
         while inner.done.load(Ordering::Acquire) < n {
             std::hint::spin_loop();
@@ -165,7 +173,7 @@ fn epoch_of(claim: u64) -> u32 {
 fn work(inner: &Inner) {
     let mut seen = 0u32;
     let waiting = |seen: u32| {
-        epoch_of(inner.claim.load(Ordering::Acquire)) == seen && !inner.stop.load(Ordering::Acquire)
+        epoch_of(inner.claim.load(Ordering::SeqCst)) == seen && !inner.stop.load(Ordering::Acquire)
     };
     loop {
         let (mut spins, start) = (0u32, std::time::Instant::now());
@@ -176,10 +184,12 @@ fn work(inner: &Inner) {
                 continue;
             }
             let job = inner.job.lock().expect("crew lock");
+            inner.sleepers.fetch_add(1, Ordering::SeqCst);
             let _job = inner
                 .wake
                 .wait_while(job, |_| waiting(seen))
                 .expect("crew lock");
+            inner.sleepers.fetch_sub(1, Ordering::SeqCst);
             break;
         }
         if inner.stop.load(Ordering::Acquire) {
