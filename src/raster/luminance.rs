@@ -374,6 +374,9 @@ struct Scratch {
     shows_now: bool,
     /// Re-shaded triangles that show now.
     reshaded_shown: Vec<u32>,
+    /// The union of the showing changed and re-shaded triangles' old boxes, and their summed
+    /// area (the render scans the union where it is no larger).
+    old_boxes: (Option<[i32; 4]>, i64),
     setup: SetupOut,
     /// Per image pixel: the render number that touched it, and its entry in `touched` (one
     /// record, so a pixel's check and its entry share a cache line).
@@ -1075,6 +1078,7 @@ impl View {
         // The old boxes' pixels are read first thing in the render: ask for them now, while
         // the set-up below runs. The boxes overlap around a moved vertex, so their union is
         // asked for once where it is no larger than the boxes together.
+        scratch.old_boxes = (rect, box_area);
         let w = shared.width as usize;
         match rect {
             Some(u) if area(u) <= box_area => prefetch_rect(&self.px, w, u),
@@ -1163,6 +1167,7 @@ impl View {
             reshading,
             pixel,
             touched,
+            old_boxes,
             ..
         } = scratch;
         touched.clear();
@@ -1180,17 +1185,13 @@ impl View {
             //    the boxes' union where that is smaller than the boxes together (they overlap around
             //    a moved vertex), else box by box.
             let mut deep: Option<[i32; 4]> = None;
-            let (mut union_box, mut box_area) = (None, 0i64);
+            let (union_box, box_area) = *old_boxes;
             let showing = changed
                 .iter()
                 .map(|&(t, _)| t)
                 .chain(reshaded_shown.iter().copied())
                 .filter(|&t| shows(&self.shown_count, t))
                 .filter_map(|t| *self.bbox.get(t as usize)?);
-            for b in showing.clone() {
-                union_box = Some(union(union_box, b));
-                box_area += area(b);
-            }
             let mut visit = |p: usize, x: i32, y: i32| {
                 let c = &self.px[p];
                 if c.shown == EMPTY || pixel[p][0] == number {
