@@ -369,7 +369,8 @@ struct SimplifyArgs {
     /// Target ratio of the input's triangles.
     #[arg(long, conflicts_with_all = ["triangles", "error", "chain"])]
     ratio: Option<f64>,
-    /// Target triangle count.
+    /// Target triangle count: the LOD has at most this many triangles (unless the mesh
+    /// cannot be simplified that far).
     #[arg(long, conflicts_with_all = ["error", "chain"])]
     triangles: Option<usize>,
     /// Target error relative to the bounding-box diagonal (qem, meshopt).

@@ -636,15 +636,6 @@ impl Adjacency {
         shared
     }
 
-    /// How many live triangles contain both `a` and `b`.
-    pub fn edge_triangle_count(&self, a: u32, b: u32) -> usize {
-        self.vtris
-            .get(a)
-            .iter()
-            .filter(|&&t| self.tris[t as usize].contains(&b))
-            .count()
-    }
-
     /// Every live edge (a < b), ascending.
     pub fn edges(&self) -> Vec<(u32, u32)> {
         let mut e: Vec<(u32, u32)> = Vec::with_capacity(3 * self.alive_count / 2 + 1);

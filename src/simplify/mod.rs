@@ -68,7 +68,7 @@ impl Method {
 pub enum Goal {
     /// Fraction of the original's triangles.
     Ratio(f64),
-    /// Triangle count.
+    /// Triangle count: at most this many, where the mesh can be simplified that far.
     Triangles(usize),
     /// Error relative to the bounding-box diagonal (each method's own error measure).
     Error(f64),

@@ -388,24 +388,25 @@ pub struct Progressive {
 }
 
 impl Progressive {
-    /// The structure after the longest prefix of collapses that leaves at least `triangles`
-    /// triangles (all collapses if `triangles` is 0).
+    /// How many of the first collapses it takes to reach at most `triangles` triangles: the
+    /// shortest such prefix, or every collapse when the run stopped above the count (it
+    /// could not go further, or `triangles` is 0).
+    fn prefix(&self, triangles: usize) -> usize {
+        self.collapses
+            .iter()
+            .position(|c| c.triangles <= triangles)
+            .map_or(self.collapses.len(), |k| k + 1)
+    }
+
+    /// The structure after the shortest prefix of collapses that leaves at most `triangles`
+    /// triangles (all collapses if none does).
     pub fn extract(&self, triangles: usize) -> Adjacency {
-        if self
-            .collapses
-            .last()
-            .is_none_or(|c| c.triangles >= triangles)
-        {
+        let n = self.prefix(triangles);
+        if n == self.collapses.len() {
             return self.last.clone();
         }
         let mut adj = self.base.clone();
-        for c in &self.collapses {
-            if adj.triangle_count() <= triangles {
-                break;
-            }
-            if c.triangles < triangles {
-                break;
-            }
+        for c in &self.collapses[..n] {
             adj.collapse(c.from, c.to, c.position)
                 .expect("a recorded collapse replays");
             for (w, v) in &c.attributes {
@@ -415,11 +416,10 @@ impl Progressive {
         adj
     }
 
-    /// The largest error among the first collapses down to `triangles`.
+    /// The largest error among the collapses [`Progressive::extract`] makes for `triangles`.
     pub fn error_at(&self, triangles: usize) -> f64 {
-        self.collapses
+        self.collapses[..self.prefix(triangles)]
             .iter()
-            .take_while(|c| c.triangles >= triangles)
             .map(|c| c.error)
             .fold(0.0, f64::max)
     }
@@ -548,23 +548,6 @@ pub fn run(adj: Adjacency, cost: &mut dyn CollapseCost, stop: Stop, diagonal: f6
         let (p, err) = cost.placement(&adj, a, b);
         if err > limit {
             break;
-        }
-        // A collapse that would take the count below a triangle target ends the run before it
-        // is made: the LOD is then `last` as it stands, the prefix `Progressive::extract` gives,
-        // with no replay from the start. (A refused collapse does not end the prefix, so it is
-        // only checked.)
-        if let Stop::Triangles(n) = stop
-            && adj.triangle_count() < n + adj.vertex_triangles(a).len()
-            && adj.triangle_count() - adj.edge_triangle_count(a, b).min(adj.triangle_count()) < n
-        {
-            let legal = adj.can_collapse(a, b, p).is_ok()
-                || (!adj.is_locked(b)
-                    && adj.class(b) <= adj.class(a)
-                    && adj.can_collapse(b, a, p).is_ok());
-            if legal {
-                break;
-            }
-            continue;
         }
         // A refused collapse changes nothing, so each direction is checked and applied in one go.
         let (from, to, map) = match adj.collapse_for_good(a, b, p, &mut ring) {
@@ -721,6 +704,33 @@ mod tests {
         assert!(one.len() > spot.triangle_count() / 3);
         assert_eq!(one, run_with(2));
         assert_eq!(one, run_with(8));
+    }
+
+    #[test]
+    fn a_triangle_target_is_an_upper_bound() {
+        // A grid whose triangles are all doubled back to back: a collapse inside it removes
+        // four triangles, one on its border two. Whatever the order of equal costs, every
+        // target the chain can reach is met from below (the run used to stop above a target
+        // when the next collapse would have jumped past it), by the shortest prefix that does.
+        let mut data = shapes::grid_plane(3).to_data();
+        let back: Vec<[u32; 3]> = data.triangles.iter().map(|&[a, b, c]| [a, c, b]).collect();
+        data.triangles.extend(back);
+        data.material_ids.clear();
+        let doubled = Mesh::new(data, &LoadOptions::default()).unwrap();
+        let pm = progressive(&doubled, Stop::Triangles(0));
+        let floor = pm.last.triangle_count();
+        assert!(floor < 10, "{floor}");
+        for t in floor..=doubled.triangle_count() {
+            let k = pm.prefix(t);
+            assert!(pm.extract(t).triangle_count() <= t, "target {t}");
+            assert!(k == 0 || pm.collapses[k - 1].triangles <= t);
+            assert!(
+                k < 2 || pm.collapses[k - 2].triangles > t,
+                "target {t}: not the shortest"
+            );
+        }
+        let (lod, _) = simplify(&doubled, Stop::Triangles(12)).unwrap();
+        assert!(lod.triangle_count() <= 12);
     }
 
     #[test]
