@@ -524,6 +524,7 @@ fn index_of_linear(y: f32) -> usize {
     // `max` returns the other operand for NaN, so the value is a number in [0.5, 65535.5]
     // here and the plain truncating conversion applies (`as` would add the saturation and
     // NaN checks of a general float-to-int cast: this runs for every shaded pixel).
+    #[allow(clippy::manual_clamp)] // `clamp` keeps a NaN, and a NaN must give 0 here.
     let v = y.max(0.0).min(1.0) * 65535.0 + 0.5;
     // SAFETY: v is finite and within u32's range, as above.
     (unsafe { v.to_int_unchecked::<u32>() }) as usize
@@ -1696,6 +1697,17 @@ mod tests {
         let cams = cameras(&mesh, n);
         let adj = Adjacency::new(&mesh);
         (Scene::new(mesh), cams, adj)
+    }
+
+    #[test]
+    fn linear_luminance_indices_clamp_and_send_nan_to_zero() {
+        assert_eq!(index_of_linear(f32::NAN), 0);
+        assert_eq!(index_of_linear(-1.0), 0);
+        assert_eq!(index_of_linear(f32::NEG_INFINITY), 0);
+        assert_eq!(index_of_linear(2.0), 65535);
+        assert_eq!(index_of_linear(f32::INFINITY), 65535);
+        assert_eq!(index_of_linear(0.5), 32768);
+        assert_eq!(index_of_linear(1.0 / 65535.0), 1);
     }
 
     #[test]
