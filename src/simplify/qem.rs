@@ -493,7 +493,8 @@ pub fn run(adj: Adjacency, cost: &mut dyn CollapseCost, stop: Stop, diagonal: f6
     // — does not depend on the thread count.
     // Each vertex costs its edges to higher vertices (each edge once), in chunks of vertices.
     // (Each chunk fills its own vector, and the chunks are joined in order: a flattened
-    // parallel iterator spent a third as much again as the costs on its bookkeeping.)
+    // parallel iterator's bookkeeping took 14 M instructions on the bunny, a fifth of the
+    // 65 M the first costs themselves take.)
     let initial: Vec<Entry> = {
         let (adj, cost, version) = (&adj, &*cost, &version);
         let vertices = adj.positions.len() as u32;
