@@ -1027,6 +1027,15 @@ impl View {
         delta
     }
 
+    /// Triangle `t`'s committed box, if it shows anywhere in this view.
+    fn old_box(&self, t: u32) -> Option<[i32; 4]> {
+        self.bbox
+            .get(t as usize)
+            .copied()
+            .flatten()
+            .filter(|_| shows(&self.shown_count, t))
+    }
+
     /// New set-up of the changed triangles and the dirty rectangle; false if it is empty.
     fn prepare(
         &self,
@@ -1048,16 +1057,9 @@ impl View {
         let mut rect: Option<[i32; 4]> = None;
         let mut shows_now = false;
         let mut box_area = 0i64;
-        let old_box = |t: u32| {
-            self.bbox
-                .get(t as usize)
-                .copied()
-                .flatten()
-                .filter(|_| shows(&self.shown_count, t))
-        };
         for &t in change.triangles {
             scratch.stamp[t as usize] = number;
-            if let Some(b) = old_box(t) {
+            if let Some(b) = self.old_box(t) {
                 rect = Some(union(rect, b));
                 box_area += area(b);
                 shows_now = true;
@@ -1068,7 +1070,7 @@ impl View {
             let tu = t as usize;
             if scratch.stamp[tu] != number && scratch.stamp[tu] != reshade {
                 scratch.stamp[tu] = reshade;
-                if let Some(b) = old_box(t) {
+                if let Some(b) = self.old_box(t) {
                     rect = Some(union(rect, b));
                     box_area += area(b);
                     shows_now = true;
@@ -1084,8 +1086,16 @@ impl View {
         match rect {
             Some(u) if area(u) <= box_area => prefetch_rect(&self.px, w, u),
             Some(_) => {
-                let showing = change.triangles.iter().copied().filter_map(old_box);
-                let reshaded = scratch.reshaded_shown.iter().copied().filter_map(old_box);
+                let showing = change
+                    .triangles
+                    .iter()
+                    .copied()
+                    .filter_map(|t| self.old_box(t));
+                let reshaded = scratch
+                    .reshaded_shown
+                    .iter()
+                    .copied()
+                    .filter_map(|t| self.old_box(t));
                 showing
                     .chain(reshaded)
                     .for_each(|b| prefetch_rect(&self.px, w, b));
@@ -1191,8 +1201,7 @@ impl View {
                 .iter()
                 .map(|&(t, _)| t)
                 .chain(reshaded_shown.iter().copied())
-                .filter(|&t| shows(&self.shown_count, t))
-                .filter_map(|t| *self.bbox.get(t as usize)?);
+                .filter_map(|t| self.old_box(t));
             let mut visit = |p: usize, x: i32, y: i32| {
                 let c = &self.px[p];
                 if c.shown == EMPTY || pixel[p][0] == number {
