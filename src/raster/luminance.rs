@@ -894,6 +894,14 @@ fn hidden(tile_far: &[f32], tiles_x: u32, st: &SetupTri) -> bool {
     tiles(tiles_x, st.bbox()).all(|tile| near > tile_far[tile])
 }
 
+/// Column and row of row-major pixel `p` in an image `width` pixels wide. In u32: a u64 → f64
+/// conversion is a branchy sequence of about ten instructions on x86-64, a u32 one is one
+/// (this runs for every shaded pixel).
+#[inline(always)]
+fn column_row(p: u32, width: u32) -> (f64, f64) {
+    ((p % width) as f64, (p / width) as f64)
+}
+
 /// Bucket tiles (row-major, `tiles_x` per row) overlapped by a pixel rectangle.
 fn tiles(tiles_x: u32, r: [i32; 4]) -> impl Iterator<Item = usize> {
     let b = BUCKET as i32;
@@ -1337,7 +1345,7 @@ impl View {
                 if id == old.shown && s != number && s != reshade {
                     old.current
                 } else if let Some((_, plane)) = last_plane.filter(|(last, _)| *last == id) {
-                    let (x, y) = ((e.p as usize % w) as f64, (e.p as usize / w) as f64);
+                    let (x, y) = column_row(e.p, shared.width);
                     shared.encode[index_of_linear(plane.at(x, y))]
                 } else {
                     let (piece, tu) = ((id & PIECE_MASK) as usize, t as usize);
@@ -1366,10 +1374,8 @@ impl View {
                         PieceShading::Plane(plane) => Some((id, *plane)),
                         _ => None,
                     };
-                    let (x, y) = (
-                        (e.p as usize % w) as f64 + 0.5,
-                        (e.p as usize / w) as f64 + 0.5,
-                    );
+                    let (x, y) = column_row(e.p, shared.width);
+                    let (x, y) = (x + 0.5, y + 0.5);
                     let piece = ShadedPiece {
                         st,
                         corners,
