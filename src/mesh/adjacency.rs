@@ -141,6 +141,15 @@ fn wedge_of(mesh: &Mesh, v: usize, vertex: u32) -> Wedge {
     }
 }
 
+/// The position of each welded vertex (`weld` maps mesh vertices to welded ones).
+fn welded_positions(mesh: &Mesh, weld: &[u32]) -> Vec<Vec3> {
+    let mut positions = vec![Vec3::ZERO; mesh.welded_vertex_count()];
+    for (v, &w) in weld.iter().enumerate() {
+        positions[w as usize] = mesh.positions()[v];
+    }
+    positions
+}
+
 /// The bits of a 10-bit `x` spread to every third bit (one axis of a 30-bit Morton code).
 fn spread_bits(x: u32) -> u32 {
     let mut x = x & 0x3ff;
@@ -172,10 +181,7 @@ impl Adjacency {
     /// Build from a mesh: weld by position, wedges from the split vertices.
     pub fn new(mesh: &Mesh) -> Adjacency {
         let weld = mesh.weld();
-        let mut positions = vec![Vec3::ZERO; mesh.welded_vertex_count()];
-        for (v, &w) in weld.iter().enumerate() {
-            positions[w as usize] = mesh.positions()[v];
-        }
+        let positions = welded_positions(mesh, &weld);
         let wedges: Vec<Wedge> = (0..mesh.vertex_count())
             .map(|v| wedge_of(mesh, v, weld[v]))
             .collect();
@@ -200,10 +206,7 @@ impl Adjacency {
     pub fn new_spatial(mesh: &Mesh) -> Adjacency {
         let weld = mesh.weld();
         let nv = mesh.welded_vertex_count();
-        let mut old_positions = vec![Vec3::ZERO; nv];
-        for (v, &w) in weld.iter().enumerate() {
-            old_positions[w as usize] = mesh.positions()[v];
-        }
+        let old_positions = welded_positions(mesh, &weld);
         // Vertices by Morton code (10 bits per axis), ties by their old number.
         let (lo, hi) = old_positions
             .iter()
