@@ -1044,6 +1044,18 @@ impl View {
             .filter(|_| shows(&self.shown_count, t))
     }
 
+    /// The committed boxes of the changed triangles and the re-shaded ones that show: the
+    /// pixels a trial re-visits first (prefetched by `prepare`, scanned by `render`).
+    fn old_boxes<'a>(
+        &'a self,
+        changed: impl Iterator<Item = u32> + 'a,
+        reshaded_shown: &'a [u32],
+    ) -> impl Iterator<Item = [i32; 4]> + 'a {
+        changed
+            .chain(reshaded_shown.iter().copied())
+            .filter_map(|t| self.old_box(t))
+    }
+
     /// New set-up of the changed triangles and the dirty rectangle; false if it is empty.
     fn prepare(
         &self,
@@ -1093,21 +1105,9 @@ impl View {
         let w = shared.width as usize;
         match rect {
             Some(u) if area(u) <= box_area => prefetch_rect(&self.px, w, u),
-            Some(_) => {
-                let showing = change
-                    .triangles
-                    .iter()
-                    .copied()
-                    .filter_map(|t| self.old_box(t));
-                let reshaded = scratch
-                    .reshaded_shown
-                    .iter()
-                    .copied()
-                    .filter_map(|t| self.old_box(t));
-                showing
-                    .chain(reshaded)
-                    .for_each(|b| prefetch_rect(&self.px, w, b));
-            }
+            Some(_) => self
+                .old_boxes(change.triangles.iter().copied(), &scratch.reshaded_shown)
+                .for_each(|b| prefetch_rect(&self.px, w, b)),
             None => {}
         }
         for &t in change.triangles {
@@ -1205,11 +1205,6 @@ impl View {
             //    a moved vertex), else box by box.
             let mut deep: Option<[i32; 4]> = None;
             let (union_box, box_area) = *old_boxes;
-            let showing = changed
-                .iter()
-                .map(|&(t, _)| t)
-                .chain(reshaded_shown.iter().copied())
-                .filter_map(|t| self.old_box(t));
             let mut visit = |p: usize, x: i32, y: i32| {
                 let c = &self.px[p];
                 if c.shown == EMPTY || pixel[p][0] == number {
@@ -1262,7 +1257,9 @@ impl View {
             };
             match union_box {
                 Some(u) if area(u) <= box_area => scan(u),
-                _ => showing.for_each(scan),
+                _ => self
+                    .old_boxes(changed.iter().map(|&(t, _)| t), reshaded_shown)
+                    .for_each(scan),
             }
             // Holes three changed layers deep (a fold, a silhouette): the unchanged triangles there,
             // through the buckets, each once.
