@@ -181,7 +181,7 @@ impl Adjacency {
     /// Build from a mesh: weld by position, wedges from the split vertices.
     pub fn new(mesh: &Mesh) -> Adjacency {
         let weld = mesh.weld();
-        let positions = welded_positions(mesh, &weld);
+        let positions = welded_positions(mesh, weld);
         let wedges: Vec<Wedge> = (0..mesh.vertex_count())
             .map(|v| wedge_of(mesh, v, weld[v]))
             .collect();
@@ -206,7 +206,7 @@ impl Adjacency {
     pub fn new_spatial(mesh: &Mesh) -> Adjacency {
         let weld = mesh.weld();
         let nv = mesh.welded_vertex_count();
-        let old_positions = welded_positions(mesh, &weld);
+        let old_positions = welded_positions(mesh, weld);
         // Vertices by Morton code (10 bits per axis), ties by their old number.
         let (lo, hi) = old_positions
             .iter()
