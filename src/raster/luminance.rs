@@ -396,6 +396,8 @@ struct Scratch {
     reshade_at: Vec<u32>,
     /// Unchanged triangles that may fill the holes.
     candidates: Vec<u32>,
+    /// The luminance planes of the pieces a render shades ([`PLANE_CACHE`] slots by piece id).
+    plane_cache: Vec<PlaneSlot>,
     /// The new shading of re-shaded triangles' pieces (from `first_piece`), made while shading.
     reshading: Vec<PieceShading>,
     number: u32,
@@ -894,6 +896,45 @@ fn hidden(tile_far: &[f32], tiles_x: u32, st: &SetupTri) -> bool {
     tiles(tiles_x, st.bbox()).all(|tile| near > tile_far[tile])
 }
 
+/// Slots of the render's plane cache (a power of two).
+const PLANE_CACHE: usize = 64;
+
+/// A cached luminance plane: piece `id`'s in the render numbered `number`.
+#[derive(Debug, Clone, Copy)]
+struct PlaneSlot {
+    number: u32,
+    id: u32,
+    plane: LumaPlane,
+}
+
+impl Default for PlaneSlot {
+    fn default() -> PlaneSlot {
+        PlaneSlot {
+            number: 0,
+            id: EMPTY,
+            plane: LumaPlane {
+                n: [0.0; 3],
+                d: [0.0; 3],
+                flat: 0.0,
+            },
+        }
+    }
+}
+
+impl PlaneSlot {
+    /// The plane, if the slot holds piece `id`'s of render `number`.
+    #[inline(always)]
+    fn get(&self, number: u32, id: u32) -> Option<&LumaPlane> {
+        (self.number == number && self.id == id).then_some(&self.plane)
+    }
+}
+
+/// Plane-cache slot of piece `id` (its triangle's low bits, mixed with the piece number).
+#[inline(always)]
+fn plane_slot(id: u32) -> usize {
+    ((id >> PIECE_BITS) ^ (id << 3)) as usize & (PLANE_CACHE - 1)
+}
+
 /// Column and row of row-major pixel `p` in an image `width` pixels wide. In u32: a u64 → f64
 /// conversion is a branchy sequence of about ten instructions on x86-64, a u32 one is one
 /// (this runs for every shaded pixel).
@@ -933,6 +974,7 @@ impl Scratch {
             self.visited.iter_mut().for_each(|s| *s = 0);
             self.reshade_at.iter_mut().for_each(|s| *s = 0);
             self.pixel.iter_mut().for_each(|s| s[0] = 0);
+            self.plane_cache.iter_mut().for_each(|s| s.number = 0);
             self.number = 1;
         }
         self.owner = None;
@@ -1187,6 +1229,7 @@ impl View {
             pixel,
             touched,
             old_boxes,
+            plane_cache,
             ..
         } = scratch;
         touched.clear();
@@ -1327,10 +1370,12 @@ impl View {
         // Shade and compare. A pixel that still shows the same piece of an unchanged triangle
         // keeps its value (its corners and attributes are as committed); only pixels showing a
         // changed or re-shaded triangle, or another piece than before, are shaded.
-        // Runs of pixels share a piece (a new piece's pixels come in a row), so the last constant-
-        // albedo piece's plane is kept at hand.
+        // The touched pixels come in scan order of the old boxes, so neighbouring entries
+        // alternate between the pieces of a ring: the constant-albedo pieces' planes are kept in
+        // a small cache by piece id (a pixel of a cached piece costs a plane evaluation, not a
+        // look-up of its piece and its shading).
         let mut delta = 0i64;
-        let mut last_plane: Option<(u32, LumaPlane)> = None;
+        plane_cache.resize(PLANE_CACHE, PlaneSlot::default());
         for e in touched.iter() {
             let old = self.px[e.p as usize];
             let id = e.id;
@@ -1341,7 +1386,7 @@ impl View {
                 let s = stamp[t as usize];
                 if id == old.shown && s != number && s != reshade {
                     old.current
-                } else if let Some((_, plane)) = last_plane.filter(|(last, _)| *last == id) {
+                } else if let Some(plane) = plane_cache[plane_slot(id)].get(number, id) {
                     let (x, y) = column_row(e.p, shared.width);
                     shared.encode[index_of_linear(plane.at(x, y))]
                 } else {
@@ -1367,10 +1412,13 @@ impl View {
                     if let PieceShading::Unknown = shading {
                         *shading = shared.piece_shading(mesh, &self.light, t, st, corners);
                     }
-                    last_plane = match shading {
-                        PieceShading::Plane(plane) => Some((id, *plane)),
-                        _ => None,
-                    };
+                    if let PieceShading::Plane(plane) = shading {
+                        plane_cache[plane_slot(id)] = PlaneSlot {
+                            number,
+                            id,
+                            plane: *plane,
+                        };
+                    }
                     let (x, y) = column_row(e.p, shared.width);
                     let (x, y) = (x + 0.5, y + 0.5);
                     let piece = ShadedPiece {
