@@ -1452,7 +1452,8 @@ impl View {
             scratch.owner = Some((self.id, self.trial.serial));
         }
         let everything = self.trial.everything;
-        // The region: old and new boxes of the changed triangles, boxes of the re-shaded ones.
+        // The region: old and new boxes of the changed triangles. (The re-shaded ones keep their
+        // pieces, so their layers stand; only their pixels are shaded again, below.)
         let mut region: Option<[i32; 4]> = None;
         for &(t, bb) in &scratch.bbox {
             if let Some(&Some(o)) = self.bbox.get(t as usize) {
@@ -1460,11 +1461,6 @@ impl View {
             }
             if let Some(n) = bb {
                 region = Some(union(region, n));
-            }
-        }
-        for &t in change.reshaded {
-            if let Some(&Some(b)) = self.bbox.get(t as usize) {
-                region = Some(union(region, b));
             }
         }
         if everything {
@@ -1519,6 +1515,24 @@ impl View {
         }
         if let Some(rect) = region {
             self.render_layers(shared, mesh, rect, scratch);
+        }
+        // The pixels showing a re-shaded triangle outside the region (inside, the render above
+        // shaded them): each is visited in the box of the triangle it shows.
+        let w = shared.width as usize;
+        let inside = |x: i32, y: i32| region.is_some_and(|r| overlap(r, [x, y, x + 1, y + 1]));
+        for &t in &scratch.reshaded_shown {
+            let Some(b) = self.bbox[t as usize] else {
+                continue;
+            };
+            for y in b[1]..b[3] {
+                for x in b[0]..b[2] {
+                    let id = self.px[y as usize * w + x as usize].shown;
+                    if id != EMPTY && id >> PIECE_BITS == t && !inside(x, y) {
+                        let current = self.shade_committed(shared, mesh, id, x, y);
+                        self.px[y as usize * w + x as usize].current = current;
+                    }
+                }
+            }
         }
         self.commits += 1;
         self.trial.saved_xf.clear();
@@ -1590,32 +1604,7 @@ impl View {
                     if id == old.shown && s != number && s != reshade {
                         old.current
                     } else {
-                        let tu = t as usize;
-                        let piece = &mut self.pieces[tu][(id & PIECE_MASK) as usize];
-                        if let PieceShading::Unknown = piece.shading {
-                            piece.shading = shared.piece_shading(
-                                mesh,
-                                &self.light,
-                                t,
-                                &piece.st,
-                                &piece.corners,
-                            );
-                        }
-                        let piece = &self.pieces[tu][(id & PIECE_MASK) as usize];
-                        let shaded = ShadedPiece {
-                            st: &piece.st,
-                            corners: &piece.corners,
-                            shading: &piece.shading,
-                        };
-                        shade(
-                            shared,
-                            mesh,
-                            &self.light,
-                            t,
-                            shaded,
-                            x as f64 + 0.5,
-                            y as f64 + 0.5,
-                        )
+                        self.shade_committed(shared, mesh, id, x, y)
                     }
                 };
                 if old.shown != id {
@@ -1657,6 +1646,37 @@ impl View {
             }
             self.tile_far[tile] = far;
         }
+    }
+
+    /// The luminance of committed piece `id` at pixel (x, y) (its shading worked out first if
+    /// it is not known).
+    fn shade_committed(
+        &mut self,
+        shared: &Shared,
+        mesh: &Adjacency,
+        id: u32,
+        x: i32,
+        y: i32,
+    ) -> u16 {
+        let t = id >> PIECE_BITS;
+        let piece = &mut self.pieces[t as usize][(id & PIECE_MASK) as usize];
+        if let PieceShading::Unknown = piece.shading {
+            piece.shading = shared.piece_shading(mesh, &self.light, t, &piece.st, &piece.corners);
+        }
+        let shaded = ShadedPiece {
+            st: &piece.st,
+            corners: &piece.corners,
+            shading: &piece.shading,
+        };
+        shade(
+            shared,
+            mesh,
+            &self.light,
+            t,
+            shaded,
+            x as f64 + 0.5,
+            y as f64 + 0.5,
+        )
     }
 
     fn revert(&mut self) {
@@ -1852,7 +1872,9 @@ mod tests {
     #[test]
     fn random_moves_keep_the_layers_and_images_of_a_fresh_render() {
         // Vertex moves large enough to fold the surface over itself (holes several changed layers
-        // deep) and normal changes (re-shaded triangles), each tried a few times in a row with
+        // deep), normal changes (re-shaded triangles), and both at once (a move that re-shades
+        // the triangles around a neighbour, beyond the moved ones' boxes, as derived normals
+        // do), each tried a few times in a row with
         // other values (as the simplex does: the views reuse their holes' fills) and then
         // accepted or reverted at random: the incremental state equals a fresh render of the
         // final mesh, all three layers of every pixel included, and the accepted ΔE add up to its
@@ -1889,6 +1911,17 @@ mod tests {
             let w0 = adj.single_wedge(v).unwrap();
             let (old_p, old_n) = (adj.positions[v as usize], adj.wedges[w0 as usize].normal);
             let normal = next() % 3 == 0;
+            // A neighbour whose normal changes with the move (half the moves).
+            let u = adj.neighbours(v)[0];
+            let wu = adj.single_wedge(u).unwrap();
+            let old_nu = adj.wedges[wu as usize].normal;
+            let with_neighbour = next() % 2 == 0;
+            let around_u: Vec<u32> = adj
+                .vertex_triangles(u)
+                .iter()
+                .copied()
+                .filter(|t| !tris.contains(t))
+                .collect();
             let mut delta = 0;
             for _ in 0..1 + next() % 3 {
                 delta = if normal {
@@ -1905,11 +1938,18 @@ mod tests {
                 } else {
                     let d = Vec3::new(unit(next()), unit(next()), unit(next()));
                     adj.positions[v as usize] = old_p + 0.6 * d;
+                    let (wedges, reshaded): (&[u32], &[u32]) = if with_neighbour {
+                        let n = Vec3::new(unit(next()), unit(next()), unit(next()));
+                        adj.wedges[wu as usize].normal = (n + old_nu).normalize_or(old_nu);
+                        (&[wu], &around_u)
+                    } else {
+                        (&[], &[])
+                    };
                     let change = Change {
                         vertices: &[v],
-                        wedges: &[],
+                        wedges,
                         triangles: &tris,
-                        reshaded: &[],
+                        reshaded,
                     };
                     views.trial(&adj, &change)
                 };
@@ -1922,6 +1962,7 @@ mod tests {
                 views.revert();
                 adj.positions[v as usize] = old_p;
                 adj.wedges[w0 as usize].normal = old_n;
+                adj.wedges[wu as usize].normal = old_nu;
             }
         }
         assert!(accepted > 20, "{accepted} accepted");
