@@ -1435,9 +1435,10 @@ impl View {
     }
 
     /// Make the pending trial the committed state. The region any changed triangle covered
-    /// before or covers now (and the re-shaded triangles' boxes) is rendered again with all three
-    /// layers: a trial keeps only what its ΔE needs, and commits are rare (one evaluation in a
-    /// hundred or so is accepted).
+    /// before or covers now is rendered again with all three layers: a trial keeps only what its
+    /// ΔE needs, and commits are rare (one evaluation in a hundred or so is accepted). The
+    /// re-shaded triangles' pixels outside it are only shaded again (their pieces, and so every
+    /// pixel's layers, stay as they were).
     fn commit(
         &mut self,
         shared: &Shared,
