@@ -896,6 +896,18 @@ fn hidden(tile_far: &[f32], tiles_x: u32, st: &SetupTri) -> bool {
     tiles(tiles_x, st.bbox()).all(|tile| near > tile_far[tile])
 }
 
+/// What the shading of a touched pixel whose plane is not cached reads and fills in: the
+/// render's scratch (see [`View::shade_touched`]).
+struct ShadeRest<'a> {
+    number: u32,
+    stamp: &'a [u32],
+    new_pieces: &'a mut [(u32, Piece)],
+    first_piece: &'a mut [u32],
+    reshade_at: &'a mut [u32],
+    reshading: &'a mut Vec<PieceShading>,
+    plane_cache: &'a mut [PlaneSlot],
+}
+
 /// Slots of the render's plane cache (a power of two).
 const PLANE_CACHE: usize = 64;
 
@@ -1376,62 +1388,95 @@ impl View {
         // look-up of its piece and its shading).
         let mut delta = 0i64;
         plane_cache.resize(PLANE_CACHE, PlaneSlot::default());
+        let mut rest = ShadeRest {
+            number,
+            stamp,
+            new_pieces,
+            first_piece,
+            reshade_at,
+            reshading,
+            plane_cache,
+        };
         for e in touched.iter() {
             let old = self.px[e.p as usize];
-            let id = e.id;
-            let luma = if id == EMPTY {
-                shared.background
+            // Most pixels show a piece whose plane is cached: that path is kept short (the rest
+            // is out of line). A cached plane is taken even where the same unchanged piece
+            // still shows, whose committed value was made by the same plane at the same pixel.
+            let luma = if let Some(plane) = rest.plane_cache[plane_slot(e.id)].get(number, e.id) {
+                let (x, y) = column_row(e.p, shared.width);
+                shared.encode[index_of_linear(plane.at(x, y))]
             } else {
-                let t = id >> PIECE_BITS;
-                let s = stamp[t as usize];
-                if id == old.shown && s != number && s != reshade {
-                    old.current
-                } else if let Some(plane) = plane_cache[plane_slot(id)].get(number, id) {
-                    let (x, y) = column_row(e.p, shared.width);
-                    shared.encode[index_of_linear(plane.at(x, y))]
-                } else {
-                    let (piece, tu) = ((id & PIECE_MASK) as usize, t as usize);
-                    let (st, corners, shading) = if s == number {
-                        let p = &mut new_pieces[first_piece[tu] as usize + piece].1;
-                        (&p.st, &p.corners, &mut p.shading)
-                    } else if s == reshade {
-                        // Its geometry as committed, its shading anew.
-                        if reshade_at[tu] != number {
-                            reshade_at[tu] = number;
-                            first_piece[tu] = reshading.len() as u32;
-                            let n = self.pieces[tu].len();
-                            reshading.extend((0..n).map(|_| PieceShading::Unknown));
-                        }
-                        let p = &self.pieces[tu][piece];
-                        let shading = &mut reshading[first_piece[tu] as usize + piece];
-                        (&p.st, &p.corners, shading)
-                    } else {
-                        let p = &mut self.pieces[tu][piece];
-                        (&p.st, &p.corners, &mut p.shading)
-                    };
-                    if let PieceShading::Unknown = shading {
-                        *shading = shared.piece_shading(mesh, &self.light, t, st, corners);
-                    }
-                    if let PieceShading::Plane(plane) = shading {
-                        plane_cache[plane_slot(id)] = PlaneSlot {
-                            number,
-                            id,
-                            plane: *plane,
-                        };
-                    }
-                    let (x, y) = column_row(e.p, shared.width);
-                    let (x, y) = (x + 0.5, y + 0.5);
-                    let piece = ShadedPiece {
-                        st,
-                        corners,
-                        shading,
-                    };
-                    shade(shared, mesh, &self.light, t, piece, x, y)
-                }
+                self.shade_touched(shared, mesh, &mut rest, e, old)
             };
             delta += sq(old.target, luma) - sq(old.target, old.current);
         }
         delta
+    }
+
+    /// The luminance of touched pixel `e` (committed as `old`) when its piece's plane is not in
+    /// the render's cache: the background, the committed value (the same unchanged piece still
+    /// shows), or the piece's shading (worked out first, and its plane cached).
+    // Out of line: inlined, its registers spilled the cached path's (9 % more instructions per
+    // evaluation on the bunny). `#[cold]` lays the cached path out straight (1.6 % fewer
+    // instructions again); on a textured mesh, where every pixel comes here, it measured no
+    // slower (Spot, 3 000 evaluations).
+    #[cold]
+    #[inline(never)]
+    fn shade_touched(
+        &mut self,
+        shared: &Shared,
+        mesh: &Adjacency,
+        rest: &mut ShadeRest,
+        e: &Touch,
+        old: Pixel,
+    ) -> u16 {
+        let id = e.id;
+        if id == EMPTY {
+            return shared.background;
+        }
+        let number = rest.number;
+        let reshade = number | RESHADE;
+        let t = id >> PIECE_BITS;
+        let s = rest.stamp[t as usize];
+        if id == old.shown && s != number && s != reshade {
+            return old.current;
+        }
+        let (piece, tu) = ((id & PIECE_MASK) as usize, t as usize);
+        let (st, corners, shading) = if s == number {
+            let p = &mut rest.new_pieces[rest.first_piece[tu] as usize + piece].1;
+            (&p.st, &p.corners, &mut p.shading)
+        } else if s == reshade {
+            // Its geometry as committed, its shading anew.
+            if rest.reshade_at[tu] != number {
+                rest.reshade_at[tu] = number;
+                rest.first_piece[tu] = rest.reshading.len() as u32;
+                let n = self.pieces[tu].len();
+                rest.reshading.extend((0..n).map(|_| PieceShading::Unknown));
+            }
+            let p = &self.pieces[tu][piece];
+            let shading = &mut rest.reshading[rest.first_piece[tu] as usize + piece];
+            (&p.st, &p.corners, shading)
+        } else {
+            let p = &mut self.pieces[tu][piece];
+            (&p.st, &p.corners, &mut p.shading)
+        };
+        if let PieceShading::Unknown = shading {
+            *shading = shared.piece_shading(mesh, &self.light, t, st, corners);
+        }
+        if let PieceShading::Plane(plane) = shading {
+            rest.plane_cache[plane_slot(id)] = PlaneSlot {
+                number,
+                id,
+                plane: *plane,
+            };
+        }
+        let (x, y) = column_row(e.p, shared.width);
+        let piece = ShadedPiece {
+            st,
+            corners,
+            shading,
+        };
+        shade(shared, mesh, &self.light, t, piece, x + 0.5, y + 0.5)
     }
 
     /// Make the pending trial the committed state. The region any changed triangle covered
