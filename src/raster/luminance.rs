@@ -941,6 +941,14 @@ impl PlaneSlot {
     }
 }
 
+/// Whether a pixel now showing piece `id` keeps its committed luminance: it showed that piece
+/// before, and the piece's triangle (stamped `s`) is neither changed nor re-shaded in render
+/// `number` (its corners and attributes are as committed).
+#[inline(always)]
+fn keeps_committed(id: u32, old_shown: u32, s: u32, number: u32) -> bool {
+    id == old_shown && s != number && s != (number | RESHADE)
+}
+
 /// Plane-cache slot of piece `id` (its triangle's low bits, mixed with the piece number).
 #[inline(always)]
 fn plane_slot(id: u32) -> usize {
@@ -1438,7 +1446,7 @@ impl View {
         let reshade = number | RESHADE;
         let t = id >> PIECE_BITS;
         let s = rest.stamp[t as usize];
-        if id == old.shown && s != number && s != reshade {
+        if keeps_committed(id, old.shown, s, number) {
             return old.current;
         }
         let (piece, tu) = ((id & PIECE_MASK) as usize, t as usize);
@@ -1572,10 +1580,10 @@ impl View {
             };
             for y in b[1]..b[3] {
                 for x in b[0]..b[2] {
-                    let id = self.px[y as usize * w + x as usize].shown;
+                    let p = y as usize * w + x as usize;
+                    let id = self.px[p].shown;
                     if id != EMPTY && id >> PIECE_BITS == t && !inside(x, y) {
-                        let current = self.shade_committed(shared, mesh, id, x, y);
-                        self.px[y as usize * w + x as usize].current = current;
+                        self.px[p].current = self.shade_committed(shared, mesh, id, x, y);
                     }
                 }
             }
@@ -1599,7 +1607,6 @@ impl View {
         scratch: &mut Scratch,
     ) {
         let number = scratch.number;
-        let reshade = number | RESHADE;
         let [x0, y0, x1, y1] = rect;
         let (w, rw) = (shared.width as usize, (x1 - x0) as usize);
         let layers = &mut scratch.layers;
@@ -1647,7 +1654,7 @@ impl View {
                 } else {
                     let t = id >> PIECE_BITS;
                     let s = stamp[t as usize];
-                    if id == old.shown && s != number && s != reshade {
+                    if keeps_committed(id, old.shown, s, number) {
                         old.current
                     } else {
                         self.shade_committed(shared, mesh, id, x, y)
