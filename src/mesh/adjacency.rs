@@ -586,6 +586,25 @@ impl Adjacency {
         }
     }
 
+    /// Ask for the cache lines of `v`'s triangles (their vertices and corner wedges), once its list
+    /// is in the cache ([`Adjacency::prefetch_triangles`] asked for that earlier). A hint only.
+    pub fn prefetch_triangle_data(&self, v: u32) {
+        for &t in self.vtris.get(v) {
+            crate::prefetch::prefetch_at(&self.tris, t);
+            crate::prefetch::prefetch_at(&self.corners, t);
+        }
+    }
+
+    /// Ask for the positions of `v`'s neighbours, once its triangles are in the cache
+    /// ([`Adjacency::prefetch_triangle_data`] asked for them earlier). A hint only.
+    pub fn prefetch_ring_positions(&self, v: u32) {
+        for &t in self.vtris.get(v) {
+            for x in self.tris[t as usize] {
+                crate::prefetch::prefetch_at(&self.positions, x);
+            }
+        }
+    }
+
     /// Vertices adjacent to `v`, ascending.
     pub fn neighbours(&self, v: u32) -> Local<u32> {
         let mut n = self.ring(v);

@@ -545,6 +545,17 @@ pub fn run(adj: Adjacency, cost: &mut dyn CollapseCost, stop: Stop, diagonal: f6
         if !e.current(&version) {
             continue;
         }
+        // The entries popped ahead had their triangle lists asked for then: the one after next
+        // now has its triangles asked for, the next its ring's positions (each stage reads what
+        // the one before fetched, a collapse earlier).
+        if let Some(n) = heap.ahead(1) {
+            adj.prefetch_triangle_data(n.a);
+            adj.prefetch_triangle_data(n.b);
+        }
+        if let Some(n) = heap.ahead(0) {
+            adj.prefetch_ring_positions(n.a);
+            adj.prefetch_ring_positions(n.b);
+        }
         let (a, b) = (e.a, e.b);
         let (p, err) = cost.placement(&adj, a, b);
         if err > limit {

@@ -139,6 +139,12 @@ impl<T: Keyed + Ord + Copy> Lookahead<T> {
         }
     }
 
+    /// The `i`-th entry popped ahead (0: the one that comes out next, unless an entry pushed
+    /// since beats it).
+    pub fn ahead(&self, i: usize) -> Option<&T> {
+        self.ahead.get(i)
+    }
+
     /// Remove and return the least entry for which `keep` holds (others may be dropped on the
     /// way). Entries newly popped ahead are handed to `fetch` first.
     pub fn pop(&mut self, keep: impl Fn(&T) -> bool, mut fetch: impl FnMut(&T)) -> Option<T> {
