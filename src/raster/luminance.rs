@@ -1197,10 +1197,20 @@ impl View {
         // Where nothing that changed shows now, the committed depths stay, and a new piece
         // behind all of them in every tile it touches (the far side of a closed mesh) cannot
         // change a pixel: the view then often has nothing to render at all.
+        let mut new_box: Option<[i32; 4]> = None;
         for (_, p) in &scratch.pieces {
             if shows_now || !hidden(&self.tile_far, self.tiles_x, &p.st) {
-                rect = Some(union(rect, p.st.bbox()));
+                new_box = Some(union(new_box, p.st.bbox()));
             }
+        }
+        if let Some(b) = new_box {
+            // The new pieces' depth tests read the committed pixels of their box: asked for
+            // here too, even where the old boxes' request covered them (that one went out
+            // before the set-up, and asking again measured faster than only asking for the
+            // part outside; asking for the second layers or the render's pixel marks as well
+            // measured slower).
+            prefetch_rect(&self.px, w, b);
+            rect = Some(union(rect, b));
         }
         let pieces = &scratch.pieces;
         for (k, &(t, _)) in pieces.iter().enumerate() {
