@@ -109,6 +109,11 @@ pub(crate) fn rasterize(
 /// Call `f(x, y, depth)` for every pixel of `clip` whose centre `st` covers: one sample at the
 /// pixel centre, with the same coverage and depth as [`rasterize`] with that one offset (for a
 /// caller that keeps its own per-pixel state, such as the luminance images' two layers).
+// Never inlined (each caller's closure is inlined into its own copy): inlined into the optimizer's
+// trial render, its loop shared registers with the render's and ran 3-4 % slower (in-process
+// A/B, alternating every 64 trials, 1 and 2 threads); whether it was inlined had changed from
+// build to build with unrelated code.
+#[inline(never)]
 pub(crate) fn rasterize_each(st: &SetupTri, clip: [i32; 4], mut f: impl FnMut(i32, i32, f32)) {
     let bbox = st.bbox();
     let (x0, y0) = (bbox[0].max(clip[0]), bbox[1].max(clip[1]));
