@@ -9,8 +9,14 @@
 //! only then sleeps on a condition variable, so back-to-back jobs find it awake.
 //!
 //! A job is `f(i)` for `i` in `0..n`; the calling thread takes part, and indices are claimed one
-//! at a time (views differ a lot in work). The caller gets control back only when every call
-//! has returned, which is what makes lending `f` (and what it borrows) to the workers sound.
+//! at a time (views differ a lot in work). The caller claims from the front, the workers from the
+//! back: a caller that runs job after job over the same items keeps most items on the same
+//! thread (all but those around where the two ends meet), so their data stays in that core's
+//! cache. (Against claims from one end over a list sorted by the last trial's work, which moved
+//! views between cores from trial to trial: 4-5 % less time in the optimizer's trials, in an
+//! in-process A/B alternating every 64 trials on 2 threads.) The caller gets control back only
+//! when every call has returned, which is what makes lending `f` (and what it borrows) to the
+//! workers sound.
 
 use std::sync::atomic::{AtomicBool, AtomicU64, AtomicUsize, Ordering};
 use std::sync::{Arc, Condvar, Mutex};
@@ -32,8 +38,9 @@ struct Job {
 unsafe impl Send for Job {}
 
 struct Inner {
-    /// (epoch << 32) | next index to claim. The epoch (the job's number) is bumped under `job`'s
-    /// lock when a job is published; workers watch it for the next job.
+    /// (epoch << 32) | (indices claimed from the back << 16) | indices claimed from the front.
+    /// The epoch (the job's number) is bumped under `job`'s lock when a job is published;
+    /// workers watch it for the next job.
     claim: AtomicU64,
     /// Calls of the current job that have returned.
     done: AtomicUsize,
@@ -85,8 +92,10 @@ impl Crew {
         Crew { inner, workers }
     }
 
-    /// Call `f(i)` for every `i` in `0..n`, spread over the crew; returns when all calls have.
+    /// Call `f(i)` for every `i` in `0..n` (at most [`MAX_JOB`]), spread over the crew; returns
+    /// when all calls have.
     pub fn run(&self, n: usize, f: &(dyn Fn(usize) + Sync)) {
+        assert!(n <= MAX_JOB, "a crew job of {n} calls");
         if self.workers.is_empty() || n <= 1 {
             (0..n).for_each(f);
             return;
@@ -115,7 +124,7 @@ impl Crew {
             let _job = inner.job.lock().expect("crew lock");
             inner.wake.notify_all();
         }
-        take_part(inner, job);
+        take_part(inner, job, End::Front);
         while inner.done.load(Ordering::Acquire) < n {
             std::hint::spin_loop();
         }
@@ -138,21 +147,36 @@ impl Drop for Crew {
     }
 }
 
-/// Claim indices of `job` and call its function until none are left.
-fn take_part(inner: &Inner, job: Job) {
+/// Calls per job: each end's count has 16 bits of the claim word.
+const MAX_JOB: usize = 0xffff;
+
+/// The end of the index range a thread claims from.
+#[derive(Clone, Copy, PartialEq)]
+enum End {
+    Front,
+    Back,
+}
+
+/// Claim indices of `job` from `end` and call its function until none are left.
+fn take_part(inner: &Inner, job: Job, end: End) {
     let mut c = inner.claim.load(Ordering::Acquire);
     loop {
-        if epoch_of(c) != job.epoch || (c as u32) >= job.n {
+        let (front, back) = (c as u32 & 0xffff, (c as u32) >> 16);
+        if epoch_of(c) != job.epoch || front + back >= job.n {
             return;
         }
+        let (next, index) = match end {
+            End::Front => (c + 1, front),
+            End::Back => (c + (1 << 16), job.n - 1 - back),
+        };
         match inner
             .claim
-            .compare_exchange_weak(c, c + 1, Ordering::AcqRel, Ordering::Acquire)
+            .compare_exchange_weak(c, next, Ordering::AcqRel, Ordering::Acquire)
         {
             Ok(_) => {
                 // SAFETY: the index was claimed under the job's epoch, so `run` is still waiting
                 // for this call (see there).
-                let call = || unsafe { (*job.f)(c as u32 as usize) };
+                let call = || unsafe { (*job.f)(index as usize) };
                 if std::panic::catch_unwind(std::panic::AssertUnwindSafe(call)).is_err() {
                     inner.panicked.store(true, Ordering::Release);
                 }
@@ -201,7 +225,7 @@ fn work(inner: &Inner) {
             .expect("crew lock")
             .expect("a published job");
         seen = job.epoch;
-        take_part(inner, job);
+        take_part(inner, job, End::Back);
     }
 }
 

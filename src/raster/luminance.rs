@@ -218,9 +218,6 @@ struct View {
     trial: Trial,
     /// Counts commits (the fills below hold for one committed state).
     commits: u64,
-    /// What the last trial visited: its pixels and new pieces (a measure of its time, for the
-    /// order the crew takes views in).
-    work: usize,
     /// The last trial's holes and re-shaded pixels with their fills.
     fills: Fills,
 }
@@ -446,40 +443,24 @@ pub struct LumaViews {
     pending_reshaded: Vec<u32>,
     /// Runs the views of a trial (made at the first trial, as many threads as rayon's pool).
     crew: Option<Crew>,
-    /// The order the crew takes the views in: most work in the last trial first, so the
-    /// threads run out of views at about the same time (the last views taken are the short
-    /// ones). Only the timing depends on it.
-    order: Vec<u32>,
 }
 
 /// Run `f` on every view, spread over `crew` (made at the first call, with as many threads as
 /// rayon's pool has, but no more than the machine has cores). Trials come thousands of times a
 /// second, and the crew stays awake between them (rayon's workers would sleep and be woken for
-/// each).
-fn each_view(
-    crew: &mut Option<Crew>,
-    views: &mut [View],
-    order: &[u32],
-    f: &(dyn Fn(&mut View) + Sync),
-) {
+/// each). The crew takes the views in the same order every time, so each view mostly stays on
+/// one core (see `crew.rs`).
+fn each_view(crew: &mut Option<Crew>, views: &mut [View], f: &(dyn Fn(&mut View) + Sync)) {
     let crew = crew.get_or_insert_with(|| {
         let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
         Crew::new(rayon::current_num_threads().min(cores))
     });
-    assert_eq!(order.len(), views.len());
     let ptr = ViewsPtr(views.as_mut_ptr());
     crew.run(views.len(), &|i| {
-        // SAFETY: `order` is a permutation of the views' indices (`by_work` keeps it one), the
-        // crew calls each `i` once (so the views borrowed are disjoint), and `run` returns only
-        // when every call has.
-        f(unsafe { &mut *ptr.at(order[i] as usize) })
+        // SAFETY: `i` < the number of views, the crew calls each `i` once (so the views
+        // borrowed are disjoint), and `run` returns only when every call has.
+        f(unsafe { &mut *ptr.at(i) })
     });
-}
-
-/// Reorder `order` (a permutation of the views) by the views' work in their last trial, most
-/// first, ties by index.
-fn by_work(order: &mut [u32], views: &[View]) {
-    order.sort_unstable_by_key(|&i| (std::cmp::Reverse(views[i as usize].work), i));
 }
 
 /// The views of a [`LumaViews`], lent to the crew: each call takes the view of its own index.
@@ -666,7 +647,6 @@ impl LumaViews {
                     id: NEXT_VIEW_ID.fetch_add(1, std::sync::atomic::Ordering::Relaxed),
                     trial: Trial::default(),
                     commits: 0,
-                    work: 0,
                     fills: Fills::default(),
                 }
             })
@@ -701,7 +681,6 @@ impl LumaViews {
             pending_triangles: Vec::new(),
             pending_reshaded: Vec::new(),
             crew: None,
-            order: (0..cameras.len() as u32).collect(),
         })
     }
 
@@ -807,15 +786,13 @@ impl LumaViews {
             views,
             wedge_material: wm,
             crew,
-            order,
             ..
         } = self;
         let total = std::sync::atomic::AtomicI64::new(0);
-        each_view(crew, views, order, &|v| {
+        each_view(crew, views, &|v| {
             let d = with_scratch(|s| v.trial(shared, mesh, wm, change, false, s));
             total.fetch_add(d, std::sync::atomic::Ordering::Relaxed);
         });
-        by_work(order, views);
         // Integer sums: the same total in any order, so for any thread count.
         total.into_inner()
     }
@@ -832,7 +809,7 @@ impl LumaViews {
             triangles: &self.pending_triangles,
             reshaded: &self.pending_reshaded,
         };
-        each_view(&mut self.crew, &mut self.views, &self.order, &|v| {
+        each_view(&mut self.crew, &mut self.views, &|v| {
             with_scratch(|s| v.commit(shared, mesh, &change, s));
         });
     }
@@ -1086,11 +1063,8 @@ impl View {
         scratch: &mut Scratch,
     ) -> i64 {
         let delta = if self.prepare(shared, mesh, change, scratch) {
-            let d = self.render(shared, mesh, scratch);
-            self.work = scratch.touched.len() + 8 * scratch.pieces.len();
-            d
+            self.render(shared, mesh, scratch)
         } else {
-            self.work = scratch.pieces.len();
             0
         };
         scratch.owner = Some((self.id, self.trial.serial));
