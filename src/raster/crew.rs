@@ -151,7 +151,7 @@ impl Drop for Crew {
 const MAX_JOB: usize = 0xffff;
 
 /// The end of the index range a thread claims from.
-#[derive(Clone, Copy, PartialEq)]
+#[derive(Clone, Copy)]
 enum End {
     Front,
     Back,
@@ -251,6 +251,35 @@ mod tests {
                     (n * n.saturating_sub(1) / 2 * round) as u64
                 );
             }
+        }
+    }
+
+    #[test]
+    fn the_caller_takes_a_prefix_and_the_worker_the_rest() {
+        // What keeps an item on one thread from job to job: the caller claims from the front and
+        // the worker from the back, so the caller's items are 0..k and the worker's k..n,
+        // however their claims interleave in time.
+        let crew = Crew::new(2);
+        let caller = std::thread::current().id();
+        for round in 0..300usize {
+            let n = 2 + round % 21;
+            let by_caller: Vec<AtomicBool> = (0..n).map(|_| AtomicBool::new(false)).collect();
+            crew.run(n, &|i| {
+                by_caller[i].store(std::thread::current().id() == caller, Ordering::Relaxed);
+                // Some work, so that the worker gets to claim too.
+                for j in 0..2000 * (i % 3 + 1) {
+                    std::hint::black_box(j);
+                }
+            });
+            let flags: Vec<bool> = by_caller
+                .iter()
+                .map(|b| b.load(Ordering::Relaxed))
+                .collect();
+            let k = flags.iter().take_while(|&&c| c).count();
+            assert!(
+                flags[k..].iter().all(|&c| !c),
+                "round {round}: caller's items {flags:?} are not a prefix"
+            );
         }
     }
 
