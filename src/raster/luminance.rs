@@ -1174,23 +1174,15 @@ impl View {
         // new box after: 3-5 % less trial time. Asking for the second and third layers or the
         // render's pixel marks as well measured slower.)
         let w = shared.width as usize;
+        let all = new_box.map_or(rect, |b| Some(union(rect, b)));
         match rect {
-            Some(u) if area(u) <= box_area => {
-                prefetch_rect(&self.px, w, union(new_box, u));
-            }
-            Some(_) => self
+            Some(u) if area(u) > box_area => self
                 .old_boxes(change.triangles.iter().copied(), &scratch.reshaded_shown)
                 .chain(new_box)
                 .for_each(|b| prefetch_rect(&self.px, w, b)),
-            None => {
-                if let Some(b) = new_box {
-                    prefetch_rect(&self.px, w, b);
-                }
-            }
+            _ => all.into_iter().for_each(|a| prefetch_rect(&self.px, w, a)),
         }
-        if let Some(b) = new_box {
-            rect = Some(union(rect, b));
-        }
+        rect = all;
         let pieces = &scratch.pieces;
         for (k, &(t, _)) in pieces.iter().enumerate() {
             if k == 0 || pieces[k - 1].0 != t {
