@@ -24,6 +24,7 @@
 
 pub mod backend;
 pub mod commands;
+pub mod cpu;
 pub mod error;
 pub mod eval;
 #[cfg(feature = "gpu")]

@@ -985,6 +985,18 @@ fn gate_result(outcome: &lodeval::eval::Outcome) -> Result<(), Error> {
 static PANIC_MESSAGE: Mutex<Option<String>> = Mutex::new(None);
 
 fn main() -> ExitCode {
+    // Before anything else: a build for newer CPUs than this one would die of an illegal
+    // instruction somewhere later.
+    let missing = lodeval::cpu::missing();
+    if !missing.is_empty() {
+        let e = Error::Usage(format!(
+            "this lodeval was built for x86-64-v3 CPUs and this CPU lacks {}; build it for this \
+             CPU with RUSTFLAGS=\"\" cargo build --release (see .cargo/config.toml)",
+            missing.join(", ")
+        ));
+        eprintln!("error: {e}");
+        return ExitCode::from(e.exit_code());
+    }
     let cli = Cli::parse();
     std::panic::set_hook(Box::new(|info| {
         if let Ok(mut slot) = PANIC_MESSAGE.lock() {
