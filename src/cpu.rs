@@ -9,22 +9,7 @@
 pub fn missing() -> Vec<&'static str> {
     #[cfg(target_arch = "x86_64")]
     {
-        missing_with(|f| match f {
-            "sse3" => std::arch::is_x86_feature_detected!("sse3"),
-            "ssse3" => std::arch::is_x86_feature_detected!("ssse3"),
-            "sse4.1" => std::arch::is_x86_feature_detected!("sse4.1"),
-            "sse4.2" => std::arch::is_x86_feature_detected!("sse4.2"),
-            "popcnt" => std::arch::is_x86_feature_detected!("popcnt"),
-            "avx" => std::arch::is_x86_feature_detected!("avx"),
-            "avx2" => std::arch::is_x86_feature_detected!("avx2"),
-            "bmi1" => std::arch::is_x86_feature_detected!("bmi1"),
-            "bmi2" => std::arch::is_x86_feature_detected!("bmi2"),
-            "fma" => std::arch::is_x86_feature_detected!("fma"),
-            "lzcnt" => std::arch::is_x86_feature_detected!("lzcnt"),
-            "movbe" => std::arch::is_x86_feature_detected!("movbe"),
-            "f16c" => std::arch::is_x86_feature_detected!("f16c"),
-            _ => false,
-        })
+        missing_with(detected)
     }
     #[cfg(not(target_arch = "x86_64"))]
     {
@@ -42,22 +27,27 @@ fn missing_with(has: impl Fn(&str) -> bool) -> Vec<&'static str> {
         .collect()
 }
 
-/// The x86-64-v2 and -v3 features, each with whether this build was compiled to use it.
-const ASSUMED: [(&str, bool); 13] = [
-    ("sse3", cfg!(target_feature = "sse3")),
-    ("ssse3", cfg!(target_feature = "ssse3")),
-    ("sse4.1", cfg!(target_feature = "sse4.1")),
-    ("sse4.2", cfg!(target_feature = "sse4.2")),
-    ("popcnt", cfg!(target_feature = "popcnt")),
-    ("avx", cfg!(target_feature = "avx")),
-    ("avx2", cfg!(target_feature = "avx2")),
-    ("bmi1", cfg!(target_feature = "bmi1")),
-    ("bmi2", cfg!(target_feature = "bmi2")),
-    ("fma", cfg!(target_feature = "fma")),
-    ("lzcnt", cfg!(target_feature = "lzcnt")),
-    ("movbe", cfg!(target_feature = "movbe")),
-    ("f16c", cfg!(target_feature = "f16c")),
-];
+/// [`ASSUMED`] and the run-time check of each of its features, from one list.
+macro_rules! features {
+    ($($name:tt),*) => {
+        /// The x86-64-v2 and -v3 features, each with whether this build was compiled to use it.
+        const ASSUMED: &[(&str, bool)] = &[$(($name, cfg!(target_feature = $name))),*];
+
+        /// Whether the running CPU has feature `name` (one of [`ASSUMED`]'s).
+        #[cfg(target_arch = "x86_64")]
+        fn detected(name: &str) -> bool {
+            match name {
+                $($name => std::arch::is_x86_feature_detected!($name),)*
+                _ => false,
+            }
+        }
+    };
+}
+
+features!(
+    "sse3", "ssse3", "sse4.1", "sse4.2", "popcnt", "avx", "avx2", "bmi1", "bmi2", "fma", "lzcnt",
+    "movbe", "f16c"
+);
 
 #[cfg(test)]
 mod tests {
