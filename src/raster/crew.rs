@@ -13,8 +13,10 @@
 //! back: a caller that runs job after job over the same items keeps most items on the same
 //! thread (all but those around where the two ends meet), so their data stays in that core's
 //! cache. (Against claims from one end over a list sorted by the last trial's work, which moved
-//! views between cores from trial to trial: 4-5 % less time in the optimizer's trials, in an
-//! in-process A/B alternating every 64 trials on 2 threads.) The caller gets control back only
+//! views between cores from trial to trial, an in-process A/B alternating every 64 trials on 2
+//! threads gave 4-5 % less time in the optimizer's trials; an A/A of that partition later showed
+//! 3.5-4.8 % of it to be the partition's bias, so the gain is about 0-1.5 %.) The caller gets
+//! control back only
 //! when every call has returned, which is what makes lending `f` (and what it borrows) to the
 //! workers sound.
 

@@ -110,9 +110,10 @@ pub(crate) fn rasterize(
 /// pixel centre, with the same coverage and depth as [`rasterize`] with that one offset (for a
 /// caller that keeps its own per-pixel state, such as the luminance images' two layers).
 // Never inlined (each caller's closure is inlined into its own copy): inlined into the optimizer's
-// trial render, its loop shared registers with the render's and ran 3-4 % slower (in-process
-// A/B, alternating every 64 trials, 1 and 2 threads); whether it was inlined had changed from
-// build to build with unrelated code.
+// trial render, its loop shared registers with the render's and ran 0.4-1.5 % slower (in-process
+// A/B alternating every 64 trials, 2 threads, the variant in each mode in turn against an A/A of
+// the same partition); whether it was inlined had changed from build to build with unrelated
+// code.
 #[inline(never)]
 pub(crate) fn rasterize_each(st: &SetupTri, clip: [i32; 4], mut f: impl FnMut(i32, i32, f32)) {
     let bbox = st.bbox();
