@@ -63,6 +63,7 @@ use smallvec::SmallVec;
 use super::clip::ClipPlanes;
 use super::crew::Crew;
 use super::edge::{self, EMPTY};
+use super::plane_run::{self, Plane as LumaPlane, index_of_linear, sq};
 use super::setup::{SetupOut, SetupTri, Viewport, XfVertex, setup_one, transform_one};
 use super::shade::{ResolvedLight, light_terms, source_barycentrics};
 use super::texture::MipTexture;
@@ -116,15 +117,6 @@ enum PieceShading {
 /// interpolated colours. The result differs from `raster::render`'s per-channel f32 arithmetic by
 /// rounding only (at most one 16-bit code, tested); within the optimizer every image is shaded
 /// this way, so energies stay exact.
-#[derive(Debug, Clone, Copy)]
-struct LumaPlane {
-    /// Coefficients of x, y and 1 (pixel centres folded into the constant) of N and of D.
-    n: [f64; 3],
-    d: [f64; 3],
-    /// Y where D vanishes (the mean of the corners, as the barycentrics' fallback).
-    flat: f32,
-}
-
 impl LumaPlane {
     /// The plane ratio of set-up triangle `st` with source-corner luminances `l`.
     fn new(st: &SetupTri, corners: &super::setup::Corners, l: [f64; 3]) -> LumaPlane {
@@ -153,17 +145,6 @@ impl LumaPlane {
         }
         let flat = ((lc[0] + lc[1] + lc[2]) / 3.0) as f32;
         LumaPlane { n, d, flat }
-    }
-
-    /// Linear luminance at pixel (x, y).
-    #[inline]
-    fn at(&self, x: f64, y: f64) -> f32 {
-        let d = self.d[0] * x + self.d[1] * y + self.d[2];
-        if d != 0.0 {
-            ((self.n[0] * x + self.n[1] * y + self.n[2]) / d) as f32
-        } else {
-            self.flat
-        }
     }
 }
 
@@ -242,21 +223,19 @@ struct Fills {
     reshaded: Vec<u32>,
     /// The holes, with what shows there once the changed triangles are taken away.
     touched: Vec<Touch>,
-    /// The re-shaded pixels, grouped by the piece they show.
-    reshaded_px: Vec<ReshadedPixel>,
-    /// Runs of `reshaded_px`: the piece shown and the end of its run.
+    /// The re-shaded pixels, grouped by the piece they show: columns, rows and targets.
+    reshaded_x: Vec<u16>,
+    reshaded_y: Vec<u16>,
+    reshaded_target: Vec<u16>,
+    /// Runs of the re-shaded pixels: the piece shown and the end of its run.
     runs: Vec<(u32, u32)>,
-    /// Σ over `reshaded_px` of (ŷ − y)², y the committed luminance.
+    /// Σ over the re-shaded pixels of (ŷ − y)², y the committed luminance.
     reshaded_committed: i64,
 }
 
-/// A pixel showing a re-shaded triangle: where it is and its target luminance.
-#[derive(Debug, Clone, Copy)]
-struct ReshadedPixel {
-    x: u16,
-    y: u16,
-    target: u16,
-}
+/// A pixel showing a re-shaded triangle, as a scan finds it: the piece shown, its column, row and
+/// target luminance.
+type ReshadedPixel = (u32, [u16; 3]);
 
 impl Fills {
     /// Whether they were made for these changed and re-shaded triangles at this commit count.
@@ -283,20 +262,24 @@ impl Fills {
         self.reshaded.clear();
         self.reshaded.extend_from_slice(reshaded);
         self.touched.clear();
-        self.reshaded_px.clear();
+        self.reshaded_x.clear();
+        self.reshaded_y.clear();
+        self.reshaded_target.clear();
         self.runs.clear();
         self.reshaded_committed = 0;
     }
 
     /// Group `pixels` (piece shown, pixel) into runs by piece, keeping scan order within a run,
     /// and mark the fills complete.
-    fn group(&mut self, pixels: &mut [(u32, ReshadedPixel)]) {
+    fn group(&mut self, pixels: &mut [ReshadedPixel]) {
         pixels.sort_by_key(|&(id, _)| id);
-        for (k, &(id, px)) in pixels.iter().enumerate() {
+        for (k, &(id, [x, y, target])) in pixels.iter().enumerate() {
             if k > 0 && pixels[k - 1].0 != id {
                 self.runs.push((pixels[k - 1].0, k as u32));
             }
-            self.reshaded_px.push(px);
+            self.reshaded_x.push(x);
+            self.reshaded_y.push(y);
+            self.reshaded_target.push(target);
         }
         if let Some(&(id, _)) = pixels.last() {
             self.runs.push((id, pixels.len() as u32));
@@ -417,7 +400,7 @@ struct Scratch {
     /// pixels no new piece wins, which the view's [`Fills`] keep).
     touched: Vec<Touch>,
     /// The re-shaded pixels a scan for fills finds, with the pieces they show.
-    reshaded_scan: Vec<(u32, ReshadedPixel)>,
+    reshaded_scan: Vec<ReshadedPixel>,
     /// A commit's region: the three nearest (depth, piece) per pixel.
     layers: Vec<[(f32, u32); 3]>,
     /// Per source triangle: the number of the render that changed it (with [`RESHADE`] set when
@@ -537,18 +520,6 @@ const NTSC: [f32; 3] = [0.299, 0.587, 0.114];
 /// Index of a linear colour's NTSC-weighted linear luminance on a 16-bit scale.
 fn luma_index(c: Vec3) -> usize {
     index_of_linear(NTSC[0] * c.x + NTSC[1] * c.y + NTSC[2] * c.z)
-}
-
-/// Index of linear luminance `y` on a 16-bit scale (clamped; NaN gives 0).
-#[inline(always)]
-fn index_of_linear(y: f32) -> usize {
-    // `max` returns the other operand for NaN, so the value is a number in [0.5, 65535.5]
-    // here and the plain truncating conversion applies (`as` would add the saturation and
-    // NaN checks of a general float-to-int cast: this runs for every shaded pixel).
-    #[allow(clippy::manual_clamp)] // `clamp` keeps a NaN, and a NaN must give 0 here.
-    let v = y.max(0.0).min(1.0) * 65535.0 + 0.5;
-    // SAFETY: v is finite and within u32's range, as above.
-    (unsafe { v.to_int_unchecked::<u32>() }) as usize
 }
 
 /// The displayed (sRGB-encoded) 16-bit code of linear luminance index `i`.
@@ -864,11 +835,6 @@ impl LumaViews {
         // Restoring a few saved values per view: cheaper than waking the thread pool.
         self.views.iter_mut().for_each(|v| v.revert());
     }
-}
-
-fn sq(t: u16, y: u16) -> i64 {
-    let d = t as i64 - y as i64;
-    d * d
 }
 
 /// Ask for the cache lines of `rect`'s pixels in row-major `px` (`w` per row) at once: every
@@ -1330,12 +1296,7 @@ impl View {
                     // Marked for this scan only (a trial marks the holes alone).
                     pixel[p][0] = number;
                     reshaded_committed += sq(c.target, c.current);
-                    let at = ReshadedPixel {
-                        x: x as u16,
-                        y: y as u16,
-                        target: c.target,
-                    };
-                    reshaded_scan.push((c.shown, at));
+                    reshaded_scan.push((c.shown, [x as u16, y as u16, c.target]));
                     return;
                 } else {
                     return;
@@ -1357,8 +1318,8 @@ impl View {
                     .old_boxes(changed.iter().map(|&(t, _)| t), reshaded_shown)
                     .for_each(scan),
             }
-            for (_, r) in reshaded_scan.iter() {
-                pixel[r.y as usize * w + r.x as usize][0] = 0;
+            for &(_, [x, y, _]) in reshaded_scan.iter() {
+                pixel[y as usize * w + x as usize][0] = 0;
             }
             // Holes three changed layers deep (a fold, a silhouette): the unchanged triangles there,
             // through the buckets, each once.
@@ -1468,18 +1429,23 @@ impl View {
             start = end as usize;
             let shading = self.reshaded_shading(shared, mesh, &mut rest, id);
             delta += match shading {
-                PieceShading::Plane(plane) => self.fills.reshaded_px[run]
-                    .iter()
-                    .map(|r| {
-                        let luma = plane.at(r.x as f64, r.y as f64);
-                        sq(r.target, shared.encode[index_of_linear(luma)])
-                    })
-                    .sum::<i64>(),
+                PieceShading::Plane(plane) => {
+                    let f = &self.fills;
+                    plane_run::sum_sq(
+                        &plane,
+                        &shared.encode,
+                        &f.reshaded_x[run.clone()],
+                        &f.reshaded_y[run.clone()],
+                        &f.reshaded_target[run],
+                    )
+                }
                 _ => {
                     let mut sum = 0;
                     for i in run {
-                        let r = self.fills.reshaded_px[i];
-                        let p = r.y as u32 * shared.width + r.x as u32;
+                        let f = &self.fills;
+                        let (x, y, target) =
+                            (f.reshaded_x[i], f.reshaded_y[i], f.reshaded_target[i]);
+                        let p = y as u32 * shared.width + x as u32;
                         let old = self.px[p as usize];
                         let e = Touch {
                             p,
@@ -1487,10 +1453,7 @@ impl View {
                             depth: old.depth,
                             deep: false,
                         };
-                        sum += sq(
-                            r.target,
-                            self.shade_touched(shared, mesh, &mut rest, &e, old),
-                        );
+                        sum += sq(target, self.shade_touched(shared, mesh, &mut rest, &e, old));
                     }
                     sum
                 }

@@ -26,6 +26,7 @@ mod edge;
 mod fixed;
 mod frame;
 pub mod luminance;
+mod plane_run;
 mod prepare;
 mod recycle;
 mod region;
