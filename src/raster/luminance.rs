@@ -1363,7 +1363,10 @@ impl View {
                 continue;
             }
             let id = (t << PIECE_BITS) | (k as u32 - first_piece[*t as usize]);
-            edge::rasterize_each(&p.st, full, |x, y, depth| {
+            // The closure takes its scalars by value and the pixel marks as a slice: captured by
+            // reference, they were loaded through a pointer at every pixel.
+            let (pixel, touched, committed) = (&mut pixel[..], &mut *touched, &self.px[..]);
+            edge::rasterize_each(&p.st, full, move |x, y, depth| {
                 let at = y as usize * w + x as usize;
                 if pixel[at][0] == number {
                     let e = &mut touched[pixel[at][1] as usize];
@@ -1372,7 +1375,7 @@ impl View {
                     }
                 } else {
                     // Not a hole: the committed piece is unchanged and competes.
-                    let c = &self.px[at];
+                    let c = &committed[at];
                     if nearer(depth, id, c.depth, c.shown) {
                         pixel[at] = [number, touched.len() as u32];
                         touched.push(Touch {
