@@ -229,6 +229,12 @@ struct Fills {
     reshaded_target: Vec<u16>,
     /// Runs of the re-shaded pixels: the piece shown and the end of its run.
     runs: Vec<(u32, u32)>,
+    /// Per run of a per-pixel shaded piece: the wedge colours and UVs its pixels' surfaces were
+    /// worked out with (see [`surface_key`]); per re-shaded pixel of such a run: its surface.
+    /// A trial that re-shades the run with the same colours and UVs (only normals changed, as
+    /// around derived normals) lights the kept surfaces instead of sampling the texture again.
+    run_keys: Vec<Option<[u32; 15]>>,
+    surfaces: Vec<(Vec3, Vec3)>,
     /// Σ over the re-shaded pixels of (ŷ − y)², y the committed luminance.
     reshaded_committed: i64,
 }
@@ -266,6 +272,8 @@ impl Fills {
         self.reshaded_y.clear();
         self.reshaded_target.clear();
         self.runs.clear();
+        self.run_keys.clear();
+        self.surfaces.clear();
         self.reshaded_committed = 0;
     }
 
@@ -284,6 +292,7 @@ impl Fills {
         if let Some(&(id, _)) = pixels.last() {
             self.runs.push((id, pixels.len() as u32));
         }
+        self.run_keys.resize(self.runs.len(), None);
         self.valid = true;
     }
 }
@@ -1442,27 +1451,44 @@ impl View {
                         &f.reshaded_target[run],
                     )
                 }
-                _ => {
-                    let mut sum = 0;
-                    for i in run {
-                        let f = &self.fills;
-                        let (x, y, target) =
-                            (f.reshaded_x[i], f.reshaded_y[i], f.reshaded_target[i]);
-                        let p = y as u32 * shared.width + x as u32;
-                        let old = self.px[p as usize];
-                        let e = Touch {
-                            p,
-                            id,
-                            depth: old.depth,
-                            deep: false,
-                        };
-                        sum += sq(target, self.shade_touched(shared, mesh, &mut rest, &e, old));
-                    }
-                    sum
-                }
+                _ => self.surface_run(shared, mesh, k, id, run),
             };
         }
         delta
+    }
+
+    /// Σ (ŷ − y′)² over run `k` of the re-shaded pixels (`run` into the fills' pixels), which
+    /// shows piece `id` of a per-pixel shaded triangle: its pixels' surfaces are worked out (and
+    /// kept) unless the fills hold them for the triangle's present colours and UVs, then lit.
+    fn surface_run(
+        &mut self,
+        shared: &Shared,
+        mesh: &Adjacency,
+        k: usize,
+        id: u32,
+        run: std::ops::Range<usize>,
+    ) -> i64 {
+        let t = id >> PIECE_BITS;
+        let key = surface_key(mesh, t);
+        let f = &mut self.fills;
+        if f.run_keys[k] != Some(key) {
+            let piece = &self.pieces[t as usize][(id & PIECE_MASK) as usize];
+            f.surfaces
+                .resize(f.reshaded_x.len(), (Vec3::ZERO, Vec3::ZERO));
+            for i in run.clone() {
+                let (x, y) = (f.reshaded_x[i] as f64 + 0.5, f.reshaded_y[i] as f64 + 0.5);
+                f.surfaces[i] = surface(shared, mesh, t, &piece.st, &piece.corners, x, y);
+            }
+            f.run_keys[k] = Some(key);
+        }
+        run.map(|i| {
+            let (b, albedo) = f.surfaces[i];
+            sq(
+                f.reshaded_target[i],
+                lit(shared, mesh, &self.light, t, b, albedo),
+            )
+        })
+        .sum()
     }
 
     /// The new shading of re-shaded piece `id` (worked out the first time a render asks).
@@ -1861,9 +1887,24 @@ fn shade(
     if let PieceShading::Plane(plane) = shading {
         return shared.encode[index_of_linear(plane.at(x - 0.5, y - 0.5))];
     }
+    let (b, albedo) = surface(shared, mesh, t, st, corners, x, y);
+    lit(shared, mesh, light, t, b, albedo)
+}
+
+/// What a per-pixel shaded piece of source triangle `t` shows at screen point (x, y) before
+/// lighting: the source barycentrics and the albedo (material colour, vertex colours, texture).
+/// It depends on the piece's geometry and its wedges' colours and UVs, not on their normals.
+fn surface(
+    shared: &Shared,
+    mesh: &Adjacency,
+    t: u32,
+    st: &SetupTri,
+    corners: &super::setup::Corners,
+    x: f64,
+    y: f64,
+) -> (Vec3, Vec3) {
     let b = source_barycentrics(st, corners, x, y);
-    let c = mesh.corners(t).map(|w| w as usize);
-    let wd = c.map(|w| &mesh.wedges[w]);
+    let wd = mesh.corners(t).map(|w| &mesh.wedges[w as usize]);
     let m = &shared.materials[mesh.material(t) as usize];
     let mut albedo = m.base_color;
     if mesh.has_colors() {
@@ -1876,9 +1917,37 @@ fn shade(
         let dy = uv_at(source_barycentrics(st, corners, x, y + 1.0)) - uv;
         albedo *= tex.sample(uv, dx, dy);
     }
+    (b, albedo)
+}
+
+/// The luminance code of `albedo` lit by triangle `t`'s corners' Gouraud terms, interpolated
+/// with source barycentrics `b`.
+#[inline]
+fn lit(
+    shared: &Shared,
+    mesh: &Adjacency,
+    light: &[(Vec3, Vec3)],
+    t: u32,
+    b: Vec3,
+    albedo: Vec3,
+) -> u16 {
+    let c = mesh.corners(t).map(|w| w as usize);
     let d = light[c[0]].0 * b.x + light[c[1]].0 * b.y + light[c[2]].0 * b.z;
     let s = light[c[0]].1 * b.x + light[c[1]].1 * b.y + light[c[2]].1 * b.z;
     shared.luma(albedo * d + s)
+}
+
+/// The wedge attributes a triangle's [`surface`] depends on (colours and UVs), as bits.
+fn surface_key(mesh: &Adjacency, t: u32) -> [u32; 15] {
+    let mut key = [0u32; 15];
+    for (k, w) in mesh.corners(t).into_iter().enumerate() {
+        let wd = &mesh.wedges[w as usize];
+        let bits = wd.color.to_array().map(f32::to_bits);
+        key[5 * k..5 * k + 3].copy_from_slice(&bits);
+        key[5 * k + 3] = wd.uv.x.to_bits();
+        key[5 * k + 4] = wd.uv.y.to_bits();
+    }
+    key
 }
 
 /// The luminance code of a linear colour, as the optimizer's images store it (for comparing a
@@ -2076,6 +2145,7 @@ mod tests {
             let tris: Vec<u32> = adj.vertex_triangles(v).to_vec();
             let w0 = adj.single_wedge(v).unwrap();
             let (old_p, old_n) = (adj.positions[v as usize], adj.wedges[w0 as usize].normal);
+            let old_colour = adj.wedges[w0 as usize].color;
             let normal = next() % 3 == 0;
             // A neighbour whose normal changes with the move (half the moves).
             let u = adj.neighbours(v)[0];
@@ -2094,6 +2164,11 @@ mod tests {
                     // A new normal: the same corners, new shading.
                     let n = Vec3::new(unit(next()), unit(next()), unit(next()));
                     adj.wedges[w0 as usize].normal = (n + old_n).normalize_or(old_n);
+                    if coloured && next() % 2 == 0 {
+                        // A new colour as well: the re-shaded pixels' surfaces change too.
+                        let c = Vec3::new(unit(next()), unit(next()), unit(next()));
+                        adj.wedges[w0 as usize].color = (c * 0.5 + Vec3::splat(0.5)).abs();
+                    }
                     let change = Change {
                         vertices: &[],
                         wedges: &[w0],
@@ -2128,6 +2203,7 @@ mod tests {
                 views.revert();
                 adj.positions[v as usize] = old_p;
                 adj.wedges[w0 as usize].normal = old_n;
+                adj.wedges[w0 as usize].color = old_colour;
                 adj.wedges[wu as usize].normal = old_nu;
             }
         }
