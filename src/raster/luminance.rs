@@ -1481,12 +1481,10 @@ impl View {
             }
             f.run_keys[k] = Some(key);
         }
+        let l = corner_light(mesh, &self.light, t);
         run.map(|i| {
             let (b, albedo) = f.surfaces[i];
-            sq(
-                f.reshaded_target[i],
-                lit(shared, mesh, &self.light, t, b, albedo),
-            )
+            sq(f.reshaded_target[i], lit_by(shared, l, b, albedo))
         })
         .sum()
     }
@@ -1931,9 +1929,20 @@ fn lit(
     b: Vec3,
     albedo: Vec3,
 ) -> u16 {
-    let c = mesh.corners(t).map(|w| w as usize);
-    let d = light[c[0]].0 * b.x + light[c[1]].0 * b.y + light[c[2]].0 * b.z;
-    let s = light[c[0]].1 * b.x + light[c[1]].1 * b.y + light[c[2]].1 * b.z;
+    lit_by(shared, corner_light(mesh, light, t), b, albedo)
+}
+
+/// Triangle `t`'s corners' Gouraud (diffuse, specular) terms.
+#[inline]
+fn corner_light(mesh: &Adjacency, light: &[(Vec3, Vec3)], t: u32) -> [(Vec3, Vec3); 3] {
+    mesh.corners(t).map(|w| light[w as usize])
+}
+
+/// [`lit`] with the corners' terms at hand.
+#[inline(always)]
+fn lit_by(shared: &Shared, l: [(Vec3, Vec3); 3], b: Vec3, albedo: Vec3) -> u16 {
+    let d = l[0].0 * b.x + l[1].0 * b.y + l[2].0 * b.z;
+    let s = l[0].1 * b.x + l[1].1 * b.y + l[2].1 * b.z;
     shared.luma(albedo * d + s)
 }
 

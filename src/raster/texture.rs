@@ -113,7 +113,15 @@ fn bilinear(level: &Level, uv: Vec2) -> Vec3 {
     let y = (1.0 - uv.y) * h - 0.5;
     let (fx, fy) = (x.floor(), y.floor());
     let (tx, ty) = (x - fx, y - fy);
-    let wrap = |i: f32, n: usize| (i as i64).rem_euclid(n as i64) as usize;
+    // Repeat wrapping; coordinates inside the texture (the usual case) need no division.
+    let wrap = |i: f32, n: usize| {
+        let (i, n) = (i as i64, n as i64);
+        (if (0..n).contains(&i) {
+            i
+        } else {
+            i.rem_euclid(n)
+        }) as usize
+    };
     let (x0, x1) = (wrap(fx, level.width), wrap(fx + 1.0, level.width));
     let (y0, y1) = (wrap(fy, level.height), wrap(fy + 1.0, level.height));
     let t = |xx: usize, yy: usize| level.texels[yy * level.width + xx];
