@@ -167,10 +167,19 @@ struct DiffArgs {
 
 #[derive(Args, Debug)]
 struct BenchArgs {
-    /// What to measure: `raster`, `metrics REF TEST`, `simplify MESH...` or `williams MESH...`.
+    /// What to measure: `raster`, `metrics REF TEST`, `simplify MESH...`, `williams MESH...` or
+    /// `optimize MESH...` (the image-driven optimizer's evaluations per second, 20 views at 256²,
+    /// on our QEM LOD of each mesh).
     what: String,
-    /// For `metrics`: the reference and test images; for `simplify`: the meshes.
+    /// For `metrics`: the reference and test images; for `simplify`, `williams` and `optimize`:
+    /// the meshes.
     images: Vec<PathBuf>,
+    /// For `optimize`: the LOD's triangle count.
+    #[arg(long, default_value_t = 1400)]
+    triangles: usize,
+    /// For `optimize`: energy evaluations per timed run.
+    #[arg(long, default_value_t = 20_000)]
+    evals: u64,
     /// For `simplify`: target ratios, comma separated.
     #[arg(long, value_delimiter = ',', default_value = "0.5,0.1,0.01")]
     ratios: Vec<f64>,
@@ -178,7 +187,7 @@ struct BenchArgs {
     #[arg(long, default_value_t = 0)]
     bumpy: u32,
     /// For `metrics`: timed runs per metric; for `simplify`: timed runs per method and ratio
-    /// (best and median reported).
+    /// (best and median reported); for `optimize`: timed optimizer runs per mesh.
     #[arg(long, default_value_t = 5)]
     runs: usize,
     /// Torus rings (triangles = 2 · rings · sides).
@@ -654,6 +663,47 @@ fn run(cli: Cli) -> Result<(), Error> {
                             r.median_changes
                         ));
                     }
+                }
+                return emit(&t);
+            }
+            if a.what == "optimize" {
+                let mut meshes = Vec::new();
+                for p in &a.images {
+                    let name = p
+                        .file_stem()
+                        .map_or_else(String::new, |s| s.to_string_lossy().into_owned());
+                    meshes.push((name, lodeval::mesh::load(p, &LoadOptions::DEFAULT)?));
+                }
+                if meshes.is_empty() {
+                    return Err(Error::Usage(
+                        "lodeval bench optimize MESH...: give at least one mesh".into(),
+                    ));
+                }
+                let rows =
+                    lodeval::commands::bench_optimize(&meshes, a.triangles, a.evals, a.runs)?;
+                if a.json {
+                    return emit_json(&rows);
+                }
+                let mut t = String::from(
+                    "| mesh | input triangles | LOD triangles | LOD vertices | views | size | threads | evaluations | runs | best /s | median /s | worst /s | set-up s |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|\n",
+                );
+                for r in &rows {
+                    t.push_str(&format!(
+                        "| {} | {} | {} | {} | {} | {} | {} | {} | {} | {:.0} | {:.0} | {:.0} | {:.2} |\n",
+                        r.mesh,
+                        r.input_triangles,
+                        r.triangles,
+                        r.vertices,
+                        r.views,
+                        r.size,
+                        r.threads,
+                        r.evaluations,
+                        r.runs,
+                        r.best_per_s,
+                        r.median_per_s,
+                        r.worst_per_s,
+                        r.setup_seconds
+                    ));
                 }
                 return emit(&t);
             }

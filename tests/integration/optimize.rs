@@ -124,3 +124,62 @@ fn bad_input_exits_2_and_writes_nothing() {
     assert_eq!(r.code, 2);
     assert!(r.stderr.contains("--normals"), "{}", r.stderr);
 }
+
+#[test]
+fn bench_optimize_reports_steady_rates_on_the_issue_case() {
+    // `lodeval bench optimize`: our QEM LOD of each mesh, 20 views at 256², timed runs; a
+    // small LOD and budget here.
+    let original = model("bunny/bunny_odedstein_3k.obj");
+    let r = lodeval([
+        "--threads",
+        "2",
+        "bench",
+        "optimize",
+        original.to_str().unwrap(),
+        "--triangles",
+        "300",
+        "--evals",
+        "1500",
+        "--runs",
+        "2",
+        "--json",
+    ]);
+    assert_eq!(r.code, 0, "{}", r.stderr);
+    let rows: serde_json::Value = serde_json::from_str(&r.stdout).unwrap();
+    let row = &rows[0];
+    assert_eq!(row["mesh"], "bunny_odedstein_3k", "{row}");
+    let tris = row["triangles"].as_u64().unwrap();
+    assert!((250..=300).contains(&tris), "{row}");
+    assert!(row["vertices"].as_u64().unwrap() > 100, "{row}");
+    assert_eq!(
+        (row["views"].as_u64(), row["size"].as_u64()),
+        (Some(20), Some(256))
+    );
+    assert_eq!(
+        (row["evaluations"].as_u64(), row["runs"].as_u64()),
+        (Some(1500), Some(2))
+    );
+    let rate = |k: &str| row[k].as_f64().unwrap();
+    assert!(rate("best_per_s") >= rate("median_per_s"), "{row}");
+    assert!(rate("median_per_s") >= rate("worst_per_s"), "{row}");
+    assert!(
+        rate("worst_per_s") > 0.0 && rate("setup_seconds") > 0.0,
+        "{row}"
+    );
+
+    // No mesh, or a budget too small to time: usage errors.
+    let r = lodeval(["bench", "optimize"]);
+    assert_eq!(r.code, 2, "{}", r.stderr);
+    assert!(r.stderr.contains("give at least one mesh"), "{}", r.stderr);
+    let r = lodeval([
+        "bench",
+        "optimize",
+        original.to_str().unwrap(),
+        "--triangles",
+        "300",
+        "--evals",
+        "0",
+    ]);
+    assert_eq!(r.code, 2, "{}", r.stderr);
+    assert!(r.stderr.contains("--evals"), "{}", r.stderr);
+}
