@@ -500,6 +500,19 @@ fn warn_short_of_goals(
     }
 }
 
+/// Load each mesh, named by its file stem (for the benchmarks' tables).
+fn named_meshes(paths: &[PathBuf]) -> Result<Vec<(String, lodeval::mesh::Mesh)>, Error> {
+    paths
+        .iter()
+        .map(|p| {
+            let name = p
+                .file_stem()
+                .map_or_else(String::new, |s| s.to_string_lossy().into_owned());
+            Ok((name, lodeval::mesh::load(p, &LoadOptions::DEFAULT)?))
+        })
+        .collect()
+}
+
 /// Write a value to stdout as pretty JSON with a trailing newline.
 fn emit_json<T: serde::Serialize>(value: &T) -> Result<(), Error> {
     let json = serde_json::to_string_pretty(value).map_err(|e| Error::Internal(e.to_string()))?;
@@ -642,11 +655,7 @@ fn run(cli: Cli) -> Result<(), Error> {
                 let mut t = String::from(
                     "| mesh | triangles | MT nodes | hierarchy s | preprocess s | budget | frames | adapt ms median | p95 | max | first frame ms | nodes changed per frame (median) |\n|---|---|---|---|---|---|---|---|---|---|---|---|\n",
                 );
-                for p in &a.images {
-                    let name = p
-                        .file_stem()
-                        .map_or_else(String::new, |s| s.to_string_lossy().into_owned());
-                    let mesh = lodeval::mesh::load(p, &LoadOptions::DEFAULT)?;
+                for (name, mesh) in named_meshes(&a.images)? {
                     for r in lodeval::commands::bench_williams(&mesh, &a.ratios, a.views)? {
                         t.push_str(&format!(
                             "| {name} | {} | {} | {:.2} | {:.2} | {} | {} | {:.2} | {:.2} | {:.2} | {:.2} | {} |\n",
@@ -667,13 +676,7 @@ fn run(cli: Cli) -> Result<(), Error> {
                 return emit(&t);
             }
             if a.what == "optimize" {
-                let mut meshes = Vec::new();
-                for p in &a.images {
-                    let name = p
-                        .file_stem()
-                        .map_or_else(String::new, |s| s.to_string_lossy().into_owned());
-                    meshes.push((name, lodeval::mesh::load(p, &LoadOptions::DEFAULT)?));
-                }
+                let meshes = named_meshes(&a.images)?;
                 if meshes.is_empty() {
                     return Err(Error::Usage(
                         "lodeval bench optimize MESH...: give at least one mesh".into(),
@@ -708,13 +711,7 @@ fn run(cli: Cli) -> Result<(), Error> {
                 return emit(&t);
             }
             if a.what == "simplify" {
-                let mut meshes = Vec::new();
-                for p in &a.images {
-                    let name = p
-                        .file_stem()
-                        .map_or_else(String::new, |s| s.to_string_lossy().into_owned());
-                    meshes.push((name, lodeval::mesh::load(p, &LoadOptions::DEFAULT)?));
-                }
+                let mut meshes = named_meshes(&a.images)?;
                 if a.bumpy > 0 {
                     meshes.push((
                         format!("bumpy-sphere-s{}", a.bumpy),

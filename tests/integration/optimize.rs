@@ -130,12 +130,14 @@ fn bench_optimize_reports_steady_rates_on_the_issue_case() {
     // `lodeval bench optimize`: our QEM LOD of each mesh, 20 views at 256², timed runs; a
     // small LOD and budget here.
     let original = model("bunny/bunny_odedstein_3k.obj");
-    let r = lodeval([
-        "--threads",
-        "2",
-        "bench",
-        "optimize",
-        original.to_str().unwrap(),
+    let bench = |extra: &[&str]| {
+        let mut args = vec!["--threads", "2", "bench", "optimize"];
+        args.extend_from_slice(extra);
+        lodeval(args)
+    };
+    let mesh = original.to_str().unwrap();
+    let r = bench(&[
+        mesh,
         "--triangles",
         "300",
         "--evals",
@@ -168,18 +170,10 @@ fn bench_optimize_reports_steady_rates_on_the_issue_case() {
     );
 
     // No mesh, or a budget too small to time: usage errors.
-    let r = lodeval(["bench", "optimize"]);
+    let r = bench(&[]);
     assert_eq!(r.code, 2, "{}", r.stderr);
     assert!(r.stderr.contains("give at least one mesh"), "{}", r.stderr);
-    let r = lodeval([
-        "bench",
-        "optimize",
-        original.to_str().unwrap(),
-        "--triangles",
-        "300",
-        "--evals",
-        "0",
-    ]);
+    let r = bench(&[mesh, "--triangles", "300", "--evals", "0"]);
     assert_eq!(r.code, 2, "{}", r.stderr);
     assert!(r.stderr.contains("--evals"), "{}", r.stderr);
 }
