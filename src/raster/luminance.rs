@@ -1458,13 +1458,12 @@ impl View {
             delta += match shading {
                 PieceShading::Plane(plane) => {
                     let f = &self.fills;
-                    plane_run::sum_sq(
-                        &plane,
-                        &shared.encode,
+                    let run = plane_run::Run::new(
                         &f.reshaded_x[run.clone()],
                         &f.reshaded_y[run.clone()],
                         &f.reshaded_target[run],
-                    )
+                    );
+                    plane_run::sum_sq(&plane, &shared.encode, run)
                 }
                 _ => self.surface_run(shared, mesh, k, id, run),
             };

@@ -49,61 +49,66 @@ pub(super) fn sq(t: u16, y: u16) -> i64 {
     d * d
 }
 
-/// Σ_k (ŷ_k − encode[index(plane at (x_k, y_k))])² over the pixels given as columns `xs`, rows
-/// `ys` and targets `targets` (equal lengths).
-pub(super) fn sum_sq(
-    plane: &Plane,
-    encode: &[u16],
-    xs: &[u16],
-    ys: &[u16],
-    targets: &[u16],
-) -> i64 {
-    assert!(xs.len() == ys.len() && ys.len() == targets.len());
+/// A run of pixels: columns, rows and target luminances, of equal lengths.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct Run<'a> {
+    x: &'a [u16],
+    y: &'a [u16],
+    target: &'a [u16],
+}
+
+impl<'a> Run<'a> {
+    /// The run of pixels (`x[k]`, `y[k]`) with targets `target[k]`.
+    ///
+    /// # Panics
+    /// If the lengths differ.
+    pub fn new(x: &'a [u16], y: &'a [u16], target: &'a [u16]) -> Run<'a> {
+        assert!(x.len() == y.len() && y.len() == target.len());
+        Run { x, y, target }
+    }
+}
+
+/// Σ_k (ŷ_k − encode[index(plane at (x_k, y_k))])² over `run`.
+pub(super) fn sum_sq(plane: &Plane, encode: &[u16], run: Run) -> i64 {
     #[cfg(all(target_arch = "x86_64", target_feature = "avx2"))]
     {
-        // SAFETY: the build targets AVX2 (`target_feature`), and the slices' lengths are equal.
-        unsafe { avx2::sum_sq(plane, encode, xs, ys, targets) }
+        // SAFETY: the build targets AVX2 (`target_feature`).
+        unsafe { avx2::sum_sq(plane, encode, run) }
     }
     #[cfg(not(all(target_arch = "x86_64", target_feature = "avx2")))]
     {
-        sum_sq_scalar(plane, encode, xs, ys, targets)
+        sum_sq_scalar(plane, encode, run)
     }
 }
 
 /// [`sum_sq`] pixel by pixel (what builds without AVX2 use, and what the vector one is tested
 /// against).
 #[cfg_attr(all(target_arch = "x86_64", target_feature = "avx2"), allow(dead_code))]
-pub(super) fn sum_sq_scalar(
-    plane: &Plane,
-    encode: &[u16],
-    xs: &[u16],
-    ys: &[u16],
-    targets: &[u16],
-) -> i64 {
-    xs.iter()
-        .zip(ys)
-        .zip(targets)
+pub(super) fn sum_sq_scalar(plane: &Plane, encode: &[u16], run: Run) -> i64 {
+    run.x
+        .iter()
+        .zip(run.y)
+        .zip(run.target)
         .map(|((&x, &y), &t)| sq(t, encode[index_of_linear(plane.at(x as f64, y as f64))]))
         .sum()
 }
 
 #[cfg(all(target_arch = "x86_64", target_feature = "avx2"))]
 mod avx2 {
-    use super::{Plane, index_of_linear, sq};
+    use super::{Plane, Run, index_of_linear, sq};
     use std::arch::x86_64::*;
 
     /// [`super::sum_sq`], four pixels at a time.
     ///
     /// # Safety
-    /// The CPU must have AVX2 and the slices must have equal lengths.
+    /// The CPU must have AVX2.
     #[target_feature(enable = "avx2")]
-    pub(super) unsafe fn sum_sq(
-        plane: &Plane,
-        encode: &[u16],
-        xs: &[u16],
-        ys: &[u16],
-        targets: &[u16],
-    ) -> i64 {
+    pub(super) unsafe fn sum_sq(plane: &Plane, encode: &[u16], run: Run) -> i64 {
+        let Run {
+            x: xs,
+            y: ys,
+            target: targets,
+        } = run;
         let n = xs.len();
         let four = n / 4 * 4;
         let [n0, n1, n2] = plane.n.map(|c| _mm256_set1_pd(c));
@@ -116,7 +121,8 @@ mod avx2 {
         let mut index = [0i32; 4];
         let mut k = 0;
         while k < four {
-            // SAFETY: k + 4 <= n, the length of all three slices; the loads are unaligned.
+            // SAFETY: k + 4 <= n, the length of all three slices (`Run::new`); the loads are
+            // unaligned.
             let (x, y) = unsafe {
                 let x = _mm_loadl_epi64(xs.as_ptr().add(k).cast());
                 let y = _mm_loadl_epi64(ys.as_ptr().add(k).cast());
@@ -193,9 +199,10 @@ mod tests {
             let xs: Vec<u16> = (0..len).map(|_| (next() % 12) as u16).collect();
             let ys: Vec<u16> = (0..len).map(|_| (next() % 12) as u16).collect();
             let ts: Vec<u16> = (0..len).map(|_| next() as u16).collect();
+            let run = Run::new(&xs, &ys, &ts);
             assert_eq!(
-                sum_sq(&plane, &encode, &xs, &ys, &ts),
-                sum_sq_scalar(&plane, &encode, &xs, &ys, &ts),
+                sum_sq(&plane, &encode, run),
+                sum_sq_scalar(&plane, &encode, run),
                 "case {case}: {plane:?}"
             );
         }
