@@ -745,7 +745,7 @@ fn run(cli: Cli) -> Result<(), Error> {
             }
             if a.what != "raster" {
                 return Err(Error::Usage(format!(
-                    "lodeval bench {}: use `raster` or `metrics REF TEST`",
+                    "lodeval bench {}: use `raster`, `metrics REF TEST`, `simplify MESH...`, `williams MESH...` or `optimize MESH...`",
                     a.what
                 )));
             }
