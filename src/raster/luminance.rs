@@ -902,6 +902,20 @@ struct ShadeRest<'a> {
     plane_cache: &'a mut [PlaneSlot],
 }
 
+impl ShadeRest<'_> {
+    /// The slot in `reshading` of piece `piece` of re-shaded triangle `t` (which has `pieces`
+    /// pieces): the triangle's slots are made, all unknown, the first time the render asks.
+    fn reshading_slot(&mut self, t: usize, pieces: usize, piece: usize) -> usize {
+        if self.reshade_at[t] != self.number {
+            self.reshade_at[t] = self.number;
+            self.first_piece[t] = self.reshading.len() as u32;
+            self.reshading
+                .extend((0..pieces).map(|_| PieceShading::Unknown));
+        }
+        self.first_piece[t] as usize + piece
+    }
+}
+
 /// Slots of the render's plane cache (a power of two).
 const PLANE_CACHE: usize = 64;
 
@@ -1512,15 +1526,9 @@ impl View {
         id: u32,
     ) -> PieceShading {
         let (t, piece) = ((id >> PIECE_BITS) as usize, (id & PIECE_MASK) as usize);
-        let number = rest.number;
-        if rest.reshade_at[t] != number {
-            rest.reshade_at[t] = number;
-            rest.first_piece[t] = rest.reshading.len() as u32;
-            let n = self.pieces[t].len();
-            rest.reshading.extend((0..n).map(|_| PieceShading::Unknown));
-        }
+        let i = rest.reshading_slot(t, self.pieces[t].len(), piece);
         let p = &self.pieces[t][piece];
-        let shading = &mut rest.reshading[rest.first_piece[t] as usize + piece];
+        let shading = &mut rest.reshading[i];
         if let PieceShading::Unknown = shading {
             *shading = shared.piece_shading(mesh, &self.light, t as u32, &p.st, &p.corners);
         }
@@ -1584,15 +1592,9 @@ impl View {
             (&p.st, &p.corners, &mut p.shading)
         } else if s == reshade {
             // Its geometry as committed, its shading anew.
-            if rest.reshade_at[tu] != number {
-                rest.reshade_at[tu] = number;
-                rest.first_piece[tu] = rest.reshading.len() as u32;
-                let n = self.pieces[tu].len();
-                rest.reshading.extend((0..n).map(|_| PieceShading::Unknown));
-            }
+            let i = rest.reshading_slot(tu, self.pieces[tu].len(), piece);
             let p = &self.pieces[tu][piece];
-            let shading = &mut rest.reshading[rest.first_piece[tu] as usize + piece];
-            (&p.st, &p.corners, shading)
+            (&p.st, &p.corners, &mut rest.reshading[i])
         } else {
             let p = &mut self.pieces[tu][piece];
             (&p.st, &p.corners, &mut p.shading)
