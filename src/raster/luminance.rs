@@ -396,6 +396,8 @@ struct Scratch {
     /// Whether a changed triangle shows now (then holes open, and no new piece may be passed
     /// over as hidden behind the committed depths).
     shows_now: bool,
+    /// Whether the view's kept fills hold for the prepared trial (asked once, by `prepare`).
+    fills_hold: bool,
     /// Re-shaded triangles that show now.
     reshaded_shown: Vec<u32>,
     /// The union of the showing changed and re-shaded triangles' old boxes, and their summed
@@ -1237,6 +1239,7 @@ impl View {
             }
         }
         scratch.shows_now = shows_now;
+        scratch.fills_hold = runs_kept;
         scratch.rect = if tr.everything {
             Some([0, 0, shared.width as i32, shared.height as i32])
         } else {
@@ -1269,6 +1272,7 @@ impl View {
             bbox: changed,
             reshaded_shown,
             shows_now,
+            fills_hold,
             stamp,
             first_piece,
             visited,
@@ -1284,7 +1288,7 @@ impl View {
         } = scratch;
         touched.clear();
         let changed_piece = |id: u32| id != EMPTY && stamp[(id >> PIECE_BITS) as usize] == number;
-        if self.fills.hold_for(self.commits, changed, reshaded_shown) {
+        if *fills_hold {
             // The same triangles changed as in the last trial, on the same committed state.
             touched.extend_from_slice(&self.fills.touched);
             for (i, e) in touched.iter().enumerate() {
