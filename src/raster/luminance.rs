@@ -2154,13 +2154,7 @@ mod tests {
         assert_eq!(adj.has_colors(), coloured);
         let mut views = LumaViews::new(&adj, &scene, &cams, w, h, Some(targets.clone())).unwrap();
         let mut energy = views.energy();
-        let mut seed = 0x2545_f491_4f6c_dd1du64;
-        let mut next = move || {
-            seed ^= seed << 13;
-            seed ^= seed >> 7;
-            seed ^= seed << 17;
-            seed
-        };
+        let mut next = crate::raster::xorshift(0x2545_f491_4f6c_dd1du64);
         let unit = |r: u64| (r % 2001) as f32 / 1000.0 - 1.0;
         let deep_before = DEEP_RENDERS.load(std::sync::atomic::Ordering::Relaxed);
         let mut accepted = 0;
@@ -2168,19 +2162,19 @@ mod tests {
         for _ in 0..80 {
             // Now and then the same vertex again, after an accept too (the fills must not
             // outlive the committed state they were made on).
-            if next() % 3 != 0 {
+            if !next().is_multiple_of(3) {
                 v = (next() % adj.positions.len() as u64) as u32;
             }
             let tris: Vec<u32> = adj.vertex_triangles(v).to_vec();
             let w0 = adj.single_wedge(v).unwrap();
             let (old_p, old_n) = (adj.positions[v as usize], adj.wedges[w0 as usize].normal);
             let old_colour = adj.wedges[w0 as usize].color;
-            let normal = next() % 3 == 0;
+            let normal = next().is_multiple_of(3);
             // A neighbour whose normal changes with the move (half the moves).
             let u = adj.neighbours(v)[0];
             let wu = adj.single_wedge(u).unwrap();
             let old_nu = adj.wedges[wu as usize].normal;
-            let with_neighbour = next() % 2 == 0;
+            let with_neighbour = next().is_multiple_of(2);
             let around_u: Vec<u32> = adj
                 .vertex_triangles(u)
                 .iter()
@@ -2193,7 +2187,7 @@ mod tests {
                     // A new normal: the same corners, new shading.
                     let n = Vec3::new(unit(next()), unit(next()), unit(next()));
                     adj.wedges[w0 as usize].normal = (n + old_n).normalize_or(old_n);
-                    if coloured && next() % 2 == 0 {
+                    if coloured && next().is_multiple_of(2) {
                         // A new colour as well: the re-shaded pixels' surfaces change too.
                         let c = Vec3::new(unit(next()), unit(next()), unit(next()));
                         adj.wedges[w0 as usize].color = (c * 0.5 + Vec3::splat(0.5)).abs();
@@ -2224,7 +2218,7 @@ mod tests {
                     views.trial(&adj, &change)
                 };
             }
-            if next() % 2 == 0 {
+            if next().is_multiple_of(2) {
                 views.commit(&adj);
                 energy += delta;
                 accepted += 1;

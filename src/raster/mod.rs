@@ -275,3 +275,14 @@ fn vertex_lighting(ctx: &shade::ShadeContext) -> Vec<(glam::Vec3, glam::Vec3)> {
         })
         .collect()
 }
+
+/// A xorshift64 generator from `seed` (non-zero), for the raster tests' reproducible random cases.
+#[cfg(test)]
+pub(crate) fn xorshift(mut seed: u64) -> impl FnMut() -> u64 {
+    move || {
+        seed ^= seed << 13;
+        seed ^= seed >> 7;
+        seed ^= seed << 17;
+        seed
+    }
+}

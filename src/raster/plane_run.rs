@@ -170,13 +170,7 @@ mod tests {
         // Planes of every kind a piece makes (steep, flat, D crossing 0 inside the run, values
         // beyond [0, 1] and NaN), over runs of every length modulo four.
         let encode: Vec<u16> = (0..=65535u32).map(|i| (i ^ 0x5a5a) as u16).collect();
-        let mut seed = 0x9e37_79b9_7f4a_7c15u64;
-        let mut next = move || {
-            seed ^= seed << 13;
-            seed ^= seed >> 7;
-            seed ^= seed << 17;
-            seed
-        };
+        let mut next = crate::raster::xorshift(0x9e37_79b9_7f4a_7c15u64);
         let unit = |r: u64| (r % 200_001) as f64 / 100_000.0 - 1.0;
         for case in 0..400 {
             let mut plane = Plane {
