@@ -239,6 +239,33 @@ pub(crate) fn setup_one(
     }
 }
 
+/// The set-up triangle (if any) of fixed-point screen corners `v` at depths `z`, for one sample
+/// at each pixel's centre of a `width` × `height` viewport: what set-up makes of an unclipped
+/// triangle, for the rasterizers' tests.
+#[cfg(test)]
+pub(crate) fn screen_triangle(
+    v: [[i32; 2]; 3],
+    z: [f32; 3],
+    width: u32,
+    height: u32,
+) -> Option<SetupTri> {
+    let half = (super::fixed::ONE_PIXEL / 2) as i32;
+    let vp = Viewport {
+        width,
+        height,
+        cull_backfaces: false,
+        sample_span: [half; 4],
+    };
+    let mut out = SetupOut::default();
+    let p = [0, 1, 2].map(|i| Projected {
+        v: v[i],
+        z: z[i],
+        inv_w: 1.0,
+    });
+    emit(0, p, None, vp, &mut out);
+    out.tris.pop()
+}
+
 /// Orient and bound one projected triangle; `bary` are its corners' barycentrics when clipped.
 fn emit(
     index: u32,
