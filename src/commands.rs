@@ -218,9 +218,7 @@ pub fn bench_raster(b: &RasterBench) -> Result<Vec<RasterBenchRow>> {
             size: b.size,
             samples: n * n,
             views: b.views,
-            // The trials' crew: the pool's threads, at most one per core (see `luminance.rs`).
-            threads: rayon::current_num_threads()
-                .min(std::thread::available_parallelism().map_or(1, |n| n.get())),
+            threads: rayon::current_num_threads(),
             ms_per_frame: secs * 1e3,
             frames_per_s: 1.0 / secs,
             mtri_per_s: mesh.triangle_count() as f64 / secs / 1e6,
@@ -829,7 +827,7 @@ pub struct OptimizeBenchRow {
     pub views: u32,
     /// Image edge in pixels (the optimizer's default).
     pub size: u32,
-    /// Threads of the pool the optimizer ran on.
+    /// Threads the optimizer's trials ran on (the pool's, at most one per core).
     pub threads: usize,
     /// Energy evaluations per run.
     pub evaluations: u64,
@@ -895,7 +893,7 @@ pub fn bench_optimize(
             vertices: input.welded_vertex_count(),
             views: options.views,
             size: options.size,
-            threads: rayon::current_num_threads(),
+            threads: crate::raster::luminance::crew_threads(),
             evaluations: evals,
             runs: rates.len(),
             best_per_s: rates[rates.len() - 1],

@@ -477,16 +477,20 @@ pub struct LumaViews {
     crew: Option<Crew>,
 }
 
-/// Run `f` on every view, spread over `crew` (made at the first call, with as many threads as
-/// rayon's pool has, but no more than the machine has cores). Trials come thousands of times a
+/// The threads the optimizer's trials run on: as many as rayon's pool has, but no more than the
+/// machine has cores (a spinning crew worker without a core of its own holds the others up).
+pub fn crew_threads() -> usize {
+    let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
+    rayon::current_num_threads().min(cores)
+}
+
+/// Run `f` on every view, spread over `crew` (made at the first call, with [`crew_threads`]
+/// threads). Trials come thousands of times a
 /// second, and the crew stays awake between them (rayon's workers would sleep and be woken for
 /// each). The crew takes the views in the same order every time, so each view mostly stays on
 /// one core (see `crew.rs`).
 fn each_view(crew: &mut Option<Crew>, views: &mut [View], f: &(dyn Fn(&mut View) + Sync)) {
-    let crew = crew.get_or_insert_with(|| {
-        let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
-        Crew::new(rayon::current_num_threads().min(cores))
-    });
+    let crew = crew.get_or_insert_with(|| Crew::new(crew_threads()));
     let ptr = ViewsPtr(views.as_mut_ptr());
     crew.run(views.len(), &|i| {
         // SAFETY: `i` < the number of views, the crew calls each `i` once (so the views
