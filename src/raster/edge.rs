@@ -135,8 +135,10 @@ pub(crate) fn rasterize_each(st: &SetupTri, clip: [i32; 4], mut f: impl FnMut(i3
     let one = super::fixed::ONE_PIXEL;
     let step_x = coef.map(|c| c[0] * one);
     let step_y = coef.map(|c| c[1] * one);
-    // 1/area on the first covered sample, as the one-sample scan does.
-    let mut inv_area = 0.0f64;
+    // 1/area before the scan (the same value as the one-sample scan's, which works it out on the
+    // first covered sample): the callers' triangles cover pixels, and the check per pixel cost
+    // more than the division.
+    let inv_area = 1.0 / st.area() as f64;
     let mut row = origin;
     for y in y0..y1 {
         let mut e = row;
@@ -145,9 +147,6 @@ pub(crate) fn rasterize_each(st: &SetupTri, clip: [i32; 4], mut f: impl FnMut(i3
         for x in x0..x1 {
             if (e[0] | e[1] | e[2]) >= 0 {
                 inside = true;
-                if inv_area == 0.0 {
-                    inv_area = 1.0 / st.area() as f64;
-                }
                 let w = [0, 1, 2].map(|i| (e[i] - bias[i]) as f64);
                 f(x, y, interpolated_depth(st, w, inv_area));
             } else if inside {
