@@ -362,6 +362,10 @@ struct Touch {
     /// A hole whose layers behind are changed too: only a rasterization of the unchanged
     /// triangles there can fill it.
     deep: bool,
+    /// A pixel of a re-shaded triangle that a new piece won: its run counts it re-shaded, which
+    /// the shading loop takes back. (Known when the new piece wins it, where the committed
+    /// piece's stamp is looked up anyway; the shading loop then needs no look-up per pixel.)
+    won_reshaded: bool,
 }
 
 /// Whether a fragment (depth, id) is nearer than (depth0, id0): nearer, or as near with a lower
@@ -1329,6 +1333,7 @@ impl View {
                             id: EMPTY,
                             depth: f32::INFINITY,
                             deep: true,
+                            won_reshaded: false,
                         }
                     } else {
                         Touch {
@@ -1336,6 +1341,7 @@ impl View {
                             id: second.shown,
                             depth: second.depth,
                             deep: false,
+                            won_reshaded: false,
                         }
                     }
                 } else if s == reshade {
@@ -1412,6 +1418,7 @@ impl View {
             // The closure takes its scalars by value and the pixel marks as a slice: captured by
             // reference, they were loaded through a pointer at every pixel.
             let (pixel, touched, committed) = (&mut pixel[..], &mut *touched, &self.px[..]);
+            let stamp = &stamp[..];
             edge::rasterize_each(&p.st, full, move |x, y, depth| {
                 let at = y as usize * w + x as usize;
                 if pixel[at][0] == number {
@@ -1424,11 +1431,13 @@ impl View {
                     let c = &committed[at];
                     if nearer(depth, id, c.depth, c.shown) {
                         pixel[at] = [number, touched.len() as u32];
+                        let s = (c.shown != EMPTY).then(|| stamp[(c.shown >> PIECE_BITS) as usize]);
                         touched.push(Touch {
                             p: at as u32,
                             id,
                             depth,
                             deep: false,
+                            won_reshaded: s == Some(reshade),
                         });
                     }
                 }
@@ -1464,7 +1473,7 @@ impl View {
                 self.shade_touched(shared, mesh, &mut rest, e, old)
             };
             delta += sq(old.target, luma) - sq(old.target, old.current);
-            if old.shown != EMPTY && rest.stamp[(old.shown >> PIECE_BITS) as usize] == reshade {
+            if e.won_reshaded {
                 // A re-shaded pixel a new piece won: its run below counts it re-shaded.
                 delta -= self.reshaded_excess(shared, mesh, &mut rest, e.p, old);
             }
@@ -1561,6 +1570,7 @@ impl View {
             id: old.shown,
             depth: old.depth,
             deep: false,
+            won_reshaded: false,
         };
         let luma = self.shade_touched(shared, mesh, rest, &e, old);
         sq(old.target, luma) - sq(old.target, old.current)
