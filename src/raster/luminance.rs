@@ -363,8 +363,8 @@ struct Touch {
     /// triangles there can fill it.
     deep: bool,
     /// A pixel of a re-shaded triangle that a new piece won: its run counts it re-shaded, which
-    /// the shading loop takes back. (Known when the new piece wins it, where the committed
-    /// piece's stamp is looked up anyway; the shading loop then needs no look-up per pixel.)
+    /// the shading loop takes back. (Worked out when the new piece wins it, where the committed
+    /// pixel is at hand, so the shading loop needs no stamp look-up per pixel.)
     won_reshaded: bool,
 }
 
