@@ -1431,13 +1431,14 @@ impl View {
                     let c = &committed[at];
                     if nearer(depth, id, c.depth, c.shown) {
                         pixel[at] = [number, touched.len() as u32];
-                        let s = (c.shown != EMPTY).then(|| stamp[(c.shown >> PIECE_BITS) as usize]);
+                        let won_reshaded =
+                            c.shown != EMPTY && stamp[(c.shown >> PIECE_BITS) as usize] == reshade;
                         touched.push(Touch {
                             p: at as u32,
                             id,
                             depth,
                             deep: false,
-                            won_reshaded: s == Some(reshade),
+                            won_reshaded,
                         });
                     }
                 }
