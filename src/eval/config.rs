@@ -16,6 +16,7 @@ use std::path::{Path, PathBuf};
 use serde::Deserialize;
 
 use crate::error::{Error, Location, Result};
+use crate::metric::vdp::Display;
 use crate::raster::{RenderSettings, SamplePattern, Shading};
 use crate::scene::{Light, Rig, Viewing};
 
@@ -191,6 +192,14 @@ pub struct ViewingConfig {
     pub distance_m: Positive,
     /// Pixels per degree, overriding the display geometry for the metrics. Default: derived.
     pub ppd: Option<Positive>,
+    /// Luminance of the display's white, cd/m² (the VDP's display model). Default value: 100.
+    pub peak_cd_m2: Positive,
+    /// Luminance of its black in a dark room, cd/m². Default value: 0.5.
+    pub black_cd_m2: NonNegative,
+    /// Room light falling on the screen, lux. Default value: 250.
+    pub ambient_lux: NonNegative,
+    /// Fraction of that light the screen reflects. Default value: 0.005.
+    pub reflectivity: UnitInterval,
 }
 
 impl Default for ViewingConfig {
@@ -201,11 +210,25 @@ impl Default for ViewingConfig {
             display_height_px: Positive(2160.0),
             distance_m: Positive(0.7),
             ppd: None,
+            peak_cd_m2: Positive(Display::DEFAULT.peak_cd_m2 as f64),
+            black_cd_m2: NonNegative(Display::DEFAULT.black_cd_m2 as f64),
+            ambient_lux: NonNegative(Display::DEFAULT.ambient_lux as f64),
+            reflectivity: UnitInterval(Display::DEFAULT.reflectivity as f64),
         }
     }
 }
 
 impl ViewingConfig {
+    /// The VDP's display model (checked by [`Config::parse`]: black below peak).
+    pub fn display(&self) -> Display {
+        Display {
+            peak_cd_m2: self.peak_cd_m2.0 as f32,
+            black_cd_m2: self.black_cd_m2.0 as f32,
+            ambient_lux: self.ambient_lux.0 as f32,
+            reflectivity: self.reflectivity.0 as f32,
+        }
+    }
+
     /// The metric stack's viewing conditions.
     pub fn viewing(&self) -> Viewing {
         match self.ppd {
@@ -462,6 +485,10 @@ checked_newtype!(
     Positive(f64), "f64", |v| v.is_finite() && v > 0.0, "use a finite number above 0"
 );
 checked_newtype!(
+    /// A finite number ≥ 0.
+    NonNegative(f64), "f64", |v| v.is_finite() && v >= 0.0, "use a finite number of at least 0"
+);
+checked_newtype!(
     /// An image edge in pixels.
     ImageSize(u32), "u32", |v| (1..=RenderSettings::MAX_SIZE).contains(&v),
     "use 1 to 16384 pixels"
@@ -575,6 +602,19 @@ impl Config {
                 path,
                 "has no [[asset]] entries",
                 "add at least one [[asset]] with a name and a mesh",
+            ));
+        }
+        let v = &self.viewing;
+        if let Err(e) = Display::new(
+            v.peak_cd_m2.0 as f32,
+            v.black_cd_m2.0 as f32,
+            v.ambient_lux.0 as f32,
+            v.reflectivity.0 as f32,
+        ) {
+            return Err(fail(
+                "black_cd_m2",
+                format!("[viewing] {e}"),
+                "set black_cd_m2 below peak_cd_m2 (an office monitor: 0.5 and 100)",
             ));
         }
         if self.metrics.is_empty() {

@@ -12,11 +12,12 @@
 //! that viewer would see them (perspective camera at distance D, the display's pixel scale, a
 //! square crop around the object with a 10 % + 4 px border, supersampled), and scored with the VDP
 //! at the display's pixels per degree (and with FLIP). The LOD is imperceptible at that size when
-//! the worst view's detection probability is at or below the configured level (default 0.5, the
-//! 1-JND point of the psychometric function). The search doubles the diameter from 4 px until the
-//! LOD becomes visible, then bisects on the logarithm of the diameter to 2 %; the smallest
-//! distance beyond which the LOD is imperceptible is the distance of the largest invisible
-//! diameter. Views: the `views` worst views of the full-size evaluation (by FLIP, else the first
+//! the worst view's detection probability is at or below the configured level (default 0.5: a
+//! coin toss, 0.84 JND on the VDP's scale, where 1 JND is the ModelFest observers' 84 %-correct
+//! threshold). Each row also gives the VDP's probability and JND at the reported size. The
+//! search doubles the diameter from 4 px until the LOD becomes visible, then bisects on the
+//! logarithm of the diameter to 2 %; the smallest distance beyond which the LOD is imperceptible
+//! is the distance of the largest invisible diameter. Views: the `views` worst views of the full-size evaluation (by FLIP, else the first
 //! metric), since the worst view decides.
 //!
 //! Engine parameters at that distance (all from the same sphere, so they agree with each other):
@@ -38,7 +39,7 @@ use super::tables::{DistanceRow, round7};
 use crate::error::Result;
 use crate::metric::LinearImage;
 use crate::metric::flip::Flip;
-use crate::metric::vdp::{Display, Vdp};
+use crate::metric::vdp::Vdp;
 use crate::raster::{self, RenderSettings, SamplePattern};
 use crate::scene::{Camera, Projection, Scene};
 
@@ -117,6 +118,7 @@ type Criterion = Box<dyn Fn(&Probe) -> bool>;
 #[derive(Debug, Clone, Copy)]
 struct Probe {
     vdp: f64,
+    vdp_jnd: f64,
     flip: f64,
 }
 
@@ -129,7 +131,7 @@ pub fn search(
 ) -> Result<Vec<DistanceRow>> {
     let display = Screen::new(viewing);
     let view = viewing.viewing();
-    let vdp = Vdp::new(&view, Display::DEFAULT);
+    let vdp = Vdp::new(&view, viewing.display());
     let flip = Flip::new(view.ppd() as f32);
     let sphere = job.original.mesh().bounding_sphere();
     let r_units = sphere.radius as f64;
@@ -149,6 +151,7 @@ pub fn search(
         let fov = 2.0 * ((size as f64 / 2.0) / display.k).atan();
         let mut worst = Probe {
             vdp: 0.0,
+            vdp_jnd: 0.0,
             flip: 0.0,
         };
         for &dir in &job.directions {
@@ -162,9 +165,10 @@ pub fn search(
             cam.far = (d_units + r_units * 1.01) as f32;
             let a = LinearImage::from(&raster::render(job.original, &cam, &s)?);
             let b = LinearImage::from(&raster::render(job.lod, &cam, &s)?);
-            let v = vdp.compare(&a, &b)?.probability;
+            let v = vdp.compare(&a, &b)?;
             let f = flip.compare(&a, &b)?.mean;
-            worst.vdp = worst.vdp.max(v);
+            worst.vdp = worst.vdp.max(v.probability);
+            worst.vdp_jnd = worst.vdp_jnd.max(v.jnd);
             worst.flip = worst.flip.max(f);
         }
         probes.insert(diameter, worst);
@@ -216,6 +220,7 @@ pub fn search(
         // limit (visible at the smallest probe, or invisible up to the largest) it is a bound.
         let resolved = hi.is_some() && lo > 0;
         let diameter = if lo == 0 { MIN_PROBE.min(max_d) } else { lo };
+        let at = probe(diameter)?;
         let r_m = r_units * job.meters_per_unit;
         let d_m = display.distance_for(r_m, diameter as f64);
         let (fraction, unreal, coverage) = display.engine_params(r_m, d_m);
@@ -234,6 +239,8 @@ pub fn search(
             diameter_px: round7(display.diameter_px(r_m, d_m)),
             resolved,
             renderer: crate::backend::CPU_RENDERER.to_string(),
+            vdp_probability: Some(round7(at.vdp)),
+            vdp_jnd: Some(round7(at.vdp_jnd)),
         });
     }
     Ok(rows)

@@ -75,7 +75,12 @@ pub fn run(plan: Plan, options: &RunOptions) -> Result<RunOutput> {
         .out_dir(&plan.config_path, options.out.as_deref());
     let cfg = &plan.config;
     let viewing = cfg.viewing.viewing();
-    let scorer = Scorer::new(&cfg.metrics, &viewing, cfg.flip_pixel_threshold.0);
+    let scorer = Scorer::new(
+        &cfg.metrics,
+        &viewing,
+        cfg.viewing.display(),
+        cfg.flip_pixel_threshold.0,
+    );
     let settings = cfg.render.settings();
     let engine = crate::backend::Engine::new(options.backend)?;
     let renderer = engine.describe();

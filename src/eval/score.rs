@@ -49,14 +49,19 @@ impl Scored {
 
 impl Scorer {
     /// Metrics `families` at `viewing`; `flip_pixel` is the per-pixel FLIP level for `flip_share`.
-    pub fn new(families: &[MetricFamily], viewing: &Viewing, flip_pixel: f64) -> Scorer {
+    pub fn new(
+        families: &[MetricFamily],
+        viewing: &Viewing,
+        display: Display,
+        flip_pixel: f64,
+    ) -> Scorer {
         let mut families = families.to_vec();
         families.sort();
         families.dedup();
         Scorer {
             families,
             flip: Flip::new(viewing.ppd() as f32),
-            vdp: Vdp::new(viewing, Display::DEFAULT),
+            vdp: Vdp::new(viewing, display),
             flip_pixel: flip_pixel as f32,
         }
     }

@@ -103,6 +103,12 @@ pub struct DistanceRow {
     /// What rendered the search's frames (always `cpu`: the search runs on the reference renderer).
     #[serde(default)]
     pub renderer: String,
+    /// The VDP's detection probability of the worst searched view at `diameter_px`.
+    #[serde(default)]
+    pub vdp_probability: Option<f64>,
+    /// The same difference in JND (1 = the observers' detection threshold).
+    #[serde(default)]
+    pub vdp_jnd: Option<f64>,
 }
 
 /// One line of `summary.csv`.
@@ -391,6 +397,8 @@ impl Columns for DistanceRow {
         "diameter_px",
         "resolved",
         "renderer",
+        "vdp_probability",
+        "vdp_jnd",
     ];
 }
 
@@ -547,6 +555,8 @@ mod tests {
             diameter_px: 1.0,
             resolved: true,
             renderer: "cpu".into(),
+            vdp_probability: Some(0.5),
+            vdp_jnd: Some(0.8),
         });
     }
 }

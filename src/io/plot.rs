@@ -123,3 +123,93 @@ pub fn line_plot(
     );
     s
 }
+
+/// A labelled point of a scatter plot: x, y and a short label drawn beside it.
+pub type LabelledPoint = (f64, f64, String);
+
+/// A square scatter plot of predictions against observations on equal axes: the identity line,
+/// a band of ±`band` around it (dashed), every point with its label, and a note line under the
+/// title (the figure of merit).
+pub fn scatter_identity(
+    title: &str,
+    note: &str,
+    x_label: &str,
+    y_label: &str,
+    points: &[LabelledPoint],
+    band: f64,
+) -> String {
+    let (size, m) = (560.0, 60.0);
+    let lo = points
+        .iter()
+        .flat_map(|p| [p.0, p.1])
+        .fold(f64::INFINITY, f64::min);
+    let hi = points
+        .iter()
+        .flat_map(|p| [p.0, p.1])
+        .fold(f64::NEG_INFINITY, f64::max);
+    let (lo, hi) = if lo.is_finite() && hi > lo {
+        (
+            ((lo - 0.05) * 4.0).floor() / 4.0,
+            ((hi + 0.05) * 4.0).ceil() / 4.0,
+        )
+    } else {
+        (0.0, 1.0)
+    };
+    let span = size - 2.0 * m;
+    let p = |v: f64| (v - lo) / (hi - lo) * span;
+    let (px, py) = (|x: f64| m + p(x), |y: f64| size - m - p(y));
+    let mut s = String::new();
+    let _ = writeln!(
+        s,
+        "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"{size}\" height=\"{size}\" font-family=\"sans-serif\" font-size=\"12\"><rect width=\"{size}\" height=\"{size}\" fill=\"#fff\"/><text x=\"{m}\" y=\"22\" font-size=\"15\">{title}</text><text x=\"{m}\" y=\"40\" fill=\"#555\">{note}</text><rect x=\"{m}\" y=\"{m}\" width=\"{span}\" height=\"{span}\" fill=\"none\" stroke=\"#888\"/>"
+    );
+    let mut t = lo;
+    while t <= hi + 1e-9 {
+        let _ = writeln!(
+            s,
+            "<line x1=\"{0:.1}\" x2=\"{0:.1}\" y1=\"{m}\" y2=\"{1:.1}\" stroke=\"#eee\"/><line y1=\"{2:.1}\" y2=\"{2:.1}\" x1=\"{m}\" x2=\"{3:.1}\" stroke=\"#eee\"/><text x=\"{0:.1}\" y=\"{4:.1}\" text-anchor=\"middle\">{t:.2}</text><text x=\"{5:.1}\" y=\"{6:.1}\" text-anchor=\"end\">{t:.2}</text>",
+            px(t),
+            size - m,
+            py(t),
+            size - m,
+            size - m + 16.0,
+            m - 4.0,
+            py(t) + 4.0
+        );
+        t += 0.25;
+    }
+    for (offset, dash) in [
+        (0.0, ""),
+        (band, " stroke-dasharray=\"5 4\""),
+        (-band, " stroke-dasharray=\"5 4\""),
+    ] {
+        let (a, b) = ((lo - offset).max(lo), (hi - offset).min(hi));
+        let _ = writeln!(
+            s,
+            "<line x1=\"{:.1}\" y1=\"{:.1}\" x2=\"{:.1}\" y2=\"{:.1}\" stroke=\"#999\"{dash}/>",
+            px(a),
+            py(a + offset),
+            px(b),
+            py(b + offset)
+        );
+    }
+    for (x, y, label) in points {
+        let _ = writeln!(
+            s,
+            "<circle cx=\"{:.1}\" cy=\"{:.1}\" r=\"3.5\" fill=\"#d95f02\" fill-opacity=\"0.8\"/><text x=\"{:.1}\" y=\"{:.1}\" font-size=\"9\" fill=\"#333\">{label}</text>",
+            px(*x),
+            py(*y),
+            px(*x) + 5.0,
+            py(*y) - 3.0
+        );
+    }
+    let _ = writeln!(
+        s,
+        "<text x=\"{:.1}\" y=\"{:.1}\" text-anchor=\"middle\">{x_label}</text><text x=\"16\" y=\"{:.1}\" transform=\"rotate(-90 16 {:.1})\" text-anchor=\"middle\">{y_label}</text></svg>",
+        size / 2.0,
+        size - 16.0,
+        size / 2.0,
+        size / 2.0
+    );
+    s
+}

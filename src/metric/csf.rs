@@ -22,6 +22,18 @@
 //!   (−1.18094, 3.14760); chromatic (0.27519, 7.00112), (0.24116, 3.78524). Values are in the
 //!   paper's normalisation; as there, they are compared with its JND-scaled signal differences.
 //!
+//! - Scott Daly 1993 in full, as the VDP uses it ([`DalyCsf`]): the CSF's dependence on the
+//!   adaptation luminance l (cd/m²) through A_l = 0.801·(1 + 0.7/l)^−0.2 and
+//!   B_l = 0.3·(1 + 100/l)^0.15, and the oblique effect through the bandwidth factor
+//!   r_θ = (1 − ob)/2·cos 4θ + (1 + ob)/2: S(ρ, θ, l) = P·min(S₁(ρ/r_θ, l), S₁(ρ, l)) with
+//!   S₁(ρ, l) = A_l·ε·ρ·e^(−B_l·ε·ρ)·√(1 + 0.06·e^(B_l·ε·ρ)). Decisions: the accommodation and
+//!   eccentricity factors are 1 (foveal viewing at a monitor's distance, where Daly's r_a is within
+//!   2 % of 1 at 0.7 m); the image-size term ((3.23·(ρ²·i²)^−0.3)^5 + 1)^−1/5 is dropped, because
+//!   fitted to ModelFest it tends to i² → ∞ (it only lowers the sensitivity to low frequencies,
+//!   which the ρ·e^(−bρ) term already does) and, kept, it would make a small crop of a large
+//!   screen less sensitive to coarse detail than the same object on the whole screen. P, ε and ob
+//!   are the VDP's fitted constants (`metric::vdp::fitted`).
+//!
 //! The lookup tables sample frequency logarithmically from [`F_MIN`] to [`F_MAX`] cycles per degree.
 
 /// Lowest tabulated frequency, cycles per degree.
@@ -40,6 +52,75 @@ pub fn daly_rushmeier(f: f64) -> f64 {
         * f
         * (-0.3 * f).exp()
         * (1.0 + 0.06 * (0.3 * f).exp()).sqrt()
+}
+
+/// Daly's 1993 CSF with its luminance dependence and oblique effect (see the module comment).
+///
+/// # Guarantees
+/// Built by [`DalyCsf::new`], all three parameters are finite and positive.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct DalyCsf {
+    peak: f64,
+    epsilon: f64,
+    oblique: f64,
+}
+
+impl DalyCsf {
+    /// Daly's CSF with absolute peak sensitivity `peak` (his P), frequency scale `epsilon` (his ε)
+    /// and oblique-effect bandwidth `oblique` (his ob; 1 = no oblique effect). `None` unless all
+    /// three are finite and positive.
+    pub fn new(peak: f64, epsilon: f64, oblique: f64) -> Option<DalyCsf> {
+        [peak, epsilon, oblique]
+            .iter()
+            .all(|v| v.is_finite() && *v > 0.0)
+            .then_some(DalyCsf {
+                peak,
+                epsilon,
+                oblique,
+            })
+    }
+
+    /// Daly's published constants: P = 250, ε = 0.9, ob = 0.78.
+    pub fn published() -> DalyCsf {
+        DalyCsf {
+            peak: 250.0,
+            epsilon: 0.9,
+            oblique: 0.78,
+        }
+    }
+
+    /// S₁(ρ, l) without P: the sensitivity along the cardinal axes, relative to P.
+    pub fn radial(&self, rho: f64, l_adapt: f64) -> f64 {
+        if rho <= 0.0 {
+            return 0.0;
+        }
+        let l = l_adapt.max(1e-4);
+        let a = 0.801 * (1.0 + 0.7 / l).powf(-0.2);
+        let b = 0.3 * (1.0 + 100.0 / l).powf(0.15);
+        let e = (b * self.epsilon * rho).exp();
+        a * self.epsilon * rho / e * (1.0 + 0.06 * e).sqrt()
+    }
+
+    /// The oblique effect's bandwidth factor r_θ for cos 4θ = `cos4theta`.
+    pub fn bandwidth(&self, cos4theta: f64) -> f64 {
+        (1.0 - self.oblique) / 2.0 * cos4theta + (1.0 + self.oblique) / 2.0
+    }
+
+    /// Absolute sensitivity (1 / threshold contrast) at `rho` cycles per degree, orientation with
+    /// cos 4θ = `cos4theta` (1 on the cardinal axes, −1 on the diagonals), adaptation `l_adapt`
+    /// cd/m².
+    pub fn sensitivity(&self, rho: f64, cos4theta: f64, l_adapt: f64) -> f64 {
+        let r_theta = self.bandwidth(cos4theta);
+        self.peak
+            * self
+                .radial(rho, l_adapt)
+                .min(self.radial(rho / r_theta, l_adapt))
+    }
+
+    /// The absolute peak sensitivity P.
+    pub fn peak(&self) -> f64 {
+        self.peak
+    }
 }
 
 /// Menzel–Guthe Table 1 fit of the Burbeck–Kelly achromatic CSF.
@@ -190,6 +271,34 @@ mod tests {
         }
         // Below the peak threshold (1/250) nothing is visible at any frequency.
         assert_eq!(csf.max_visible_frequency(0.9 / 250.0), None);
+    }
+
+    #[test]
+    fn daly_full_csf_has_his_luminance_and_orientation_dependence() {
+        let c = DalyCsf::published();
+        // At 100 cd/m² and the cardinal orientation the full form reduces to the same shape as
+        // Rushmeier's approximation (theirs is this one at a fixed adaptation level): it peaks
+        // between 2 and 5 cpd.
+        let peak_f = (1..400)
+            .map(|i| i as f64 * 0.05)
+            .max_by(|a, b| {
+                c.sensitivity(*a, 1.0, 100.0)
+                    .total_cmp(&c.sensitivity(*b, 1.0, 100.0))
+            })
+            .unwrap();
+        assert!((2.0..=5.0).contains(&peak_f), "{peak_f}");
+        // Sensitivity falls in the dark, most at high frequencies (the peak moves down).
+        for f in [1.0, 4.0, 16.0] {
+            assert!(c.sensitivity(f, 1.0, 1.0) < c.sensitivity(f, 1.0, 100.0));
+        }
+        let loss = |f: f64| c.sensitivity(f, 1.0, 1.0) / c.sensitivity(f, 1.0, 100.0);
+        assert!(loss(16.0) < loss(2.0));
+        // Oblique gratings are seen worse at high frequencies, not at low ones.
+        assert!(c.sensitivity(20.0, -1.0, 100.0) < 0.8 * c.sensitivity(20.0, 1.0, 100.0));
+        assert!((c.sensitivity(1.0, -1.0, 100.0) - c.sensitivity(1.0, 1.0, 100.0)).abs() < 1e-9);
+        assert!(
+            DalyCsf::new(0.0, 1.0, 1.0).is_none() && DalyCsf::new(1.0, f64::NAN, 1.0).is_none()
+        );
     }
 
     #[test]

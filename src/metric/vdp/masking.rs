@@ -1,4 +1,4 @@
-//! Stage 4 of the VDP: visual masking — how much a signal already in the image raises the
+//! Stage 5 of the VDP: visual masking — how much a signal already in the image raises the
 //! threshold for seeing a change.
 //!
 //! Based on: Scott Daly. The Visible Differences Predictor. 1993 — threshold elevation
@@ -7,10 +7,12 @@
 //! difference cannot mask itself. Gordon Legge, John Foley. Contrast Masking in Human Vision.
 //! JOSA 1980 — the slope of about 0.7 above threshold for similar frequency and orientation.
 //!
-//! Here band contrasts are already CSF-weighted and in JND units (1 = detection threshold), which is
-//! exactly the normalisation k1·k2^s = 1 of Daly's form, leaving T_e = (1 + m^(s·b))^(1/b) with
-//! s = 0.7, b = 4: no elevation far below threshold, a slope of 0.7 far above it. Masking is phase
-//! insensitive, so the masker magnitude is averaged over a 3×3 neighbourhood of the band.
+//! Band contrasts arrive CSF-weighted (`filter.rs`): one unit is one threshold contrast, which is
+//! the normalisation k1·k2^s = 1 of Daly's form, leaving T_e = (1 + m^(s·b))^(1/b) with s = 0.7,
+//! b = 4: no elevation far below threshold, a slope of 0.7 far above it. Masking is phase
+//! insensitive, so the masker magnitude is |band| averaged over a 3×3 neighbourhood of the band's
+//! samples. ModelFest cannot calibrate this stage (its stimuli are shown on a uniform field, where
+//! the masker is 0); its constants are the published ones.
 
 /// Masking slope s (Legge & Foley 1980; Daly 1993).
 pub const SLOPE: f32 = 0.7;
@@ -22,22 +24,31 @@ pub fn threshold_elevation(m: f32) -> f32 {
     (1.0 + m.abs().powf(SLOPE * B)).powf(1.0 / B)
 }
 
-/// 3×3 mean of |v| (phase-insensitive masker magnitude), mirrored borders.
+/// 3×3 mean of |v| (phase-insensitive masker magnitude), borders clamped.
 pub(crate) fn local_magnitude(v: &[f32], w: usize, h: usize) -> Vec<f32> {
-    (0..w * h)
-        .map(|i| {
-            let (x, y) = ((i % w) as isize, (i / w) as isize);
-            let mut s = 0.0;
-            for dy in -1..=1 {
-                for dx in -1..=1 {
-                    let xx = (x + dx).clamp(0, w as isize - 1) as usize;
-                    let yy = (y + dy).clamp(0, h as isize - 1) as usize;
-                    s += v[yy * w + xx].abs();
-                }
-            }
-            s / 9.0
-        })
-        .collect()
+    use rayon::prelude::*;
+    // Horizontal 3-sums of |v|, then vertical 3-sums of those.
+    let mut row3 = vec![0.0f32; w * h];
+    row3.par_chunks_mut(w).enumerate().for_each(|(y, out)| {
+        let r = &v[y * w..(y + 1) * w];
+        for (x, o) in out.iter_mut().enumerate() {
+            let (a, c) = (x.saturating_sub(1), (x + 1).min(w - 1));
+            *o = r[a].abs() + r[x].abs() + r[c].abs();
+        }
+    });
+    let mut out = vec![0.0f32; w * h];
+    out.par_chunks_mut(w).enumerate().for_each(|(y, o)| {
+        let (a, c) = (y.saturating_sub(1), (y + 1).min(h - 1));
+        let (ra, rb, rc) = (
+            &row3[a * w..][..w],
+            &row3[y * w..][..w],
+            &row3[c * w..][..w],
+        );
+        for x in 0..w {
+            o[x] = (ra[x] + rb[x] + rc[x]) * (1.0 / 9.0);
+        }
+    });
+    out
 }
 
 #[cfg(test)]

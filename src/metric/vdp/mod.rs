@@ -1,80 +1,130 @@
-//! A visible-difference predictor (VDP): the probability that a person sees a difference between
-//! two images, per pixel and overall, and the size of that difference in just-noticeable
-//! differences (JND).
+//! A visible-difference predictor (VDP), calibrated on ModelFest: the probability that a person
+//! sees a difference between two images, per pixel and overall, and its size in just-noticeable
+//! differences (JND), where 1 JND is the detection threshold of ModelFest's observers.
 //!
 //! Based on: Scott Daly. The Visible Differences Predictor: An Algorithm for the Assessment of
-//! Image Fidelity. Digital Images and Human Vision 1993 (the architecture: amplitude
-//! non-linearity, CSF, multi-channel decomposition, masking with mutual masking, psychometric
-//! function, probability summation); Jeffrey Lubin. A Visual Discrimination Model for Imaging
-//! System Design and Evaluation. 1995 (Laplacian-pyramid channels); Rafał Mantiuk, Karol
-//! Myszkowski, Hans-Peter Seidel. Visible Difference Predicator for High Dynamic Range Images.
-//! IEEE SMC 2004 (JND-scaled luminance instead of a fixed adaptation level).
+//! Image Fidelity. Digital Images and Human Vision 1993 (the architecture: CSF filter, channel
+//! decomposition, masking with mutual masking, psychometric function, probability summation; his
+//! CSF); Andrew Watson, Albert Ahumada. A standard model for foveal detection of spatial contrast.
+//! Journal of Vision 5(9) 2005 (what ModelFest needs: a CSF filter and Minkowski summation over
+//! space in degrees); Rafał Mantiuk et al. HDR-VDP-2. ACM TOG 30(4) 2011 (display model, per-band
+//! sensitivity at the local adaptation luminance).
 //!
 //! The stages, one file each, in the order they run:
-//! 1. `amplitude.rs` — display luminance, then the JND-scaled response (luminance adaptation: TVI).
-//! 2. `bands.rs` — Laplacian pyramid (octave bands) with four cos²-tuned orientation channels.
-//! 3. CSF weighting (here): each band's responses are multiplied by the normalised CSF at its
-//!    centre frequency, Daly's CSF in the Rushmeier approximation ([`crate::metric::csf`]), at the
-//!    viewing condition's pixels per degree; the result is in JND units at every frequency.
-//! 4. `masking.rs` — threshold elevation from the smaller of the two images' local channel
-//!    magnitudes (mutual masking).
-//! 5. `psychometric.rs` — d = |Δ| / elevation per channel and sample; Weibull psychometric function
-//!    and probability summation over channels, bands and pixels.
+//! 1. `display.rs` — linear pixels → luminance L in cd/m² (peak, black level, ambient reflection);
+//!    then ln L, whose small differences are Weber contrasts.
+//! 2. `filter.rs` — the CSF (Daly's, fitted) as a linear filter in the DCT domain, at the reference
+//!    adaptation luminance: every frequency weighted by its absolute sensitivity, so one unit is one
+//!    threshold contrast. The CSF contains the eye's optics (it was measured through them).
+//! 3. `bands.rs` — Laplacian pyramid of the filtered image (octave bands, exact collapse).
+//! 4. `adaptation.rs` — each band's sensitivity moved from the reference luminance to the local
+//!    adaptation luminance (Gaussian pyramid of L): Weber's law when bright, de Vries–Rose in the dark.
+//! 5. `masking.rs` — per band, the difference divided by the threshold elevation of the smaller of
+//!    the two images' local band magnitudes (mutual masking).
+//! 6. `pooling.rs` — the masked bands collapsed into one difference image d(x); Minkowski sum
+//!    S = Σ|d|^β·(pixel area in deg²), and a per-pixel map over a small neighbourhood.
+//! 7. `psychometric.rs` — P_det = 1 − exp(−k·S), J = S^(1/β); S = 1 is the observers' threshold.
 //!
-//! Calibration: one unit of the response is one luminance JND at the CSF's peak frequency, so a
-//! grating of Michelson contrast c at the peak frequency on a bright background has about 100·c
-//! JND of amplitude in the pyramid (the band gain is below 1, which makes absolute thresholds
-//! within a factor of about two of the human peak sensitivity of ≈ 200). The tests check the
-//! behaviour vision science establishes — the CSF's shape across frequency, masking, the TVI and
-//! ranking along an LOD chain — rather than absolute agreement with an observer panel, which no
-//! dataset within reach provides.
+//! Without a masker (a uniform reference, as in ModelFest) the collapse returns the CSF-filtered
+//! difference itself, so the calibrated part is exactly Watson & Ahumada's single-channel model,
+//! with Daly's CSF: `fitted.rs` holds its four constants, and `modelfest.rs` runs the check
+//! (`lodeval calibrate modelfest`). What ModelFest cannot calibrate — luminance dependence and
+//! masking — keeps its published constants and is tested against the psychophysics it comes from.
+//!
+//! Why the previous model said P = 1.000 for every non-identical pair: it summed |d|^β over every
+//! band's samples upsampled to full resolution with no unit of area, so the sum grew with the
+//! pixel count (a 512² image has 262 144 "detectors"), and its absolute scale was never fitted.
+//! Here the sum is over visual angle and its scale is the observers'.
 
-mod amplitude;
+mod adaptation;
 mod bands;
+mod display;
+mod filter;
+pub mod fitted;
 mod masking;
+pub mod modelfest;
+mod pooling;
 mod psychometric;
+
+use std::sync::{Arc, Mutex};
 
 use rayon::prelude::*;
 
-pub use amplitude::Display;
+pub use display::Display;
 pub use masking::threshold_elevation;
-pub use psychometric::BETA;
+pub use pooling::MAP_WINDOW_DEG;
+pub use psychometric::{THRESHOLD_PROBABILITY, sum_for_probability};
 
-use self::bands::{Band, ORIENTATIONS, Plane};
-use super::csf::{ClampedCsf, daly_rushmeier};
+use self::adaptation::BandAdaptation;
+use self::bands::Plane;
+use self::filter::CsfFilter;
+use super::csf::DalyCsf;
 use super::image::{ErrorMap, LinearImage, same_dims, same_size};
-use crate::error::Result;
+use crate::error::{Error, Result};
+use crate::metric::color::luminance;
 use crate::scene::Viewing;
 
-/// Value of a band-`k` sample grid at full-resolution pixel (x, y), bilinear between sample
-/// centres ((x + ½)/2^k − ½), clamped at the borders.
-fn bilinear(v: &[f64], bw: usize, bh: usize, x: usize, y: usize, k: usize) -> f64 {
-    let scale = (1u64 << k) as f64;
-    let fx = ((x as f64 + 0.5) / scale - 0.5).clamp(0.0, (bw - 1) as f64);
-    let fy = ((y as f64 + 0.5) / scale - 0.5).clamp(0.0, (bh - 1) as f64);
-    let (x0, y0) = (fx.floor() as usize, fy.floor() as usize);
-    let (x1, y1) = ((x0 + 1).min(bw - 1), (y0 + 1).min(bh - 1));
-    let (tx, ty) = (fx - x0 as f64, fy - y0 as f64);
-    let top = v[y0 * bw + x0] * (1.0 - tx) + v[y0 * bw + x1] * tx;
-    let bottom = v[y1 * bw + x0] * (1.0 - tx) + v[y1 * bw + x1] * tx;
-    top * (1.0 - ty) + bottom * ty
+/// The model's free parameters (the fitted ones by default; others for fitting and experiments).
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[non_exhaustive]
+pub struct VdpParams {
+    /// The CSF. Default value: Daly's with [`fitted::PEAK_SENSITIVITY`], [`fitted::FREQUENCY_SCALE`]
+    /// and [`fitted::OBLIQUE`].
+    pub csf: DalyCsf,
+    /// Minkowski exponent and psychometric slope. Default value: [`fitted::BETA`].
+    pub beta: f64,
 }
+
+impl VdpParams {
+    /// The ModelFest fit.
+    pub fn fitted() -> VdpParams {
+        VdpParams {
+            csf: DalyCsf::new(
+                fitted::PEAK_SENSITIVITY,
+                fitted::FREQUENCY_SCALE,
+                fitted::OBLIQUE,
+            )
+            .expect("the fitted constants are positive"),
+            beta: fitted::BETA,
+        }
+    }
+
+    /// Parameters from a CSF and an exponent; `None` unless `beta` is finite and ≥ 1.
+    pub fn new(csf: DalyCsf, beta: f64) -> Option<VdpParams> {
+        (beta.is_finite() && beta >= 1.0).then_some(VdpParams { csf, beta })
+    }
+}
+
+impl Default for VdpParams {
+    fn default() -> Self {
+        Self::fitted()
+    }
+}
+
+/// How many CSF filters (one per image size) a [`Vdp`] keeps.
+const FILTER_CACHE: usize = 4;
 
 /// The VDP for one display and viewing condition.
 #[derive(Debug, Clone)]
 pub struct Vdp {
     ppd: f64,
     display: Display,
+    params: VdpParams,
     max_levels: usize,
-    csf_peak: f64,
+    /// Per band (and one more for the residual): the luminance correction.
+    adaptation: Vec<BandAdaptation>,
+    /// The most recently used CSF filters, newest last (a cache: results do not depend on it).
+    filters: Arc<Mutex<Vec<Arc<CsfFilter>>>>,
 }
 
-/// One image after the per-image stages (response and decomposition).
+/// One image after the per-image stages (display, filter, bands, adaptation, masker magnitudes).
 #[derive(Debug, Clone)]
 pub struct VdpPrepared {
     width: usize,
     height: usize,
-    bands: Vec<Band>,
+    bands: Vec<Plane>,
+    maskers: Vec<Vec<f32>>,
+    residual: Plane,
 }
 
 /// What the VDP predicts for an image pair.
@@ -82,10 +132,11 @@ pub struct VdpPrepared {
 pub struct VdpScore {
     /// Probability that the difference is detected anywhere in the image, in [0, 1].
     pub probability: f64,
-    /// The difference in JND (Minkowski sum with exponent β over channels and pixels);
-    /// probability = 1 − exp(−jnd^β).
+    /// The difference in JND: 1 is the observers' detection threshold (P = 0.68, 2AFC 84 %
+    /// correct); probability = 1 − exp(−k·jnd^β) with k = 1.139.
     pub jnd: f64,
-    /// Per-pixel detection probability in [0, 1].
+    /// Per-pixel detection probability in [0, 1] of the difference around the pixel
+    /// ([`MAP_WINDOW_DEG`]); never above `probability`.
     pub map: ErrorMap,
 }
 
@@ -93,68 +144,138 @@ impl Vdp {
     /// Default number of pyramid levels (octaves); fewer when the image is small.
     pub const DEFAULT_LEVELS: usize = 8;
 
-    /// A VDP for `viewing` on `display`.
+    /// The calibrated VDP for `viewing` on `display`. Callers check the viewing condition
+    /// ([`Vdp::checked`] does).
     pub fn new(viewing: &Viewing, display: Display) -> Vdp {
-        let peak_f = ClampedCsf::daly().peak_frequency();
-        Vdp {
-            ppd: viewing.ppd(),
-            display,
-            max_levels: Self::DEFAULT_LEVELS,
-            csf_peak: daly_rushmeier(peak_f),
+        Self::with_params(viewing.ppd(), display, VdpParams::fitted())
+    }
+
+    /// The calibrated VDP, or a usage error naming the condition that makes no sense (pixels per
+    /// degree not finite and positive; the display is checked by [`Display::new`]).
+    pub fn checked(viewing: &Viewing, display: Display) -> Result<Vdp> {
+        let ppd = viewing.ppd();
+        if !ppd.is_finite() || ppd <= 0.0 || ppd > 1e4 {
+            return Err(Error::Usage(format!(
+                "the viewing condition gives {ppd} pixels per degree; give a positive display \
+                 width, pixel count and distance (or --ppd between 0 and 10000)"
+            )));
         }
+        let display = Display::new(
+            display.peak_cd_m2,
+            display.black_cd_m2,
+            display.ambient_lux,
+            display.reflectivity,
+        )?;
+        Ok(Self::new(viewing, display))
+    }
+
+    /// A VDP at `ppd` pixels per degree with explicit parameters (fitting, experiments).
+    pub fn with_params(ppd: f64, display: Display, params: VdpParams) -> Vdp {
+        let max_levels = Self::DEFAULT_LEVELS;
+        let adaptation = (0..=max_levels)
+            .map(|k| {
+                BandAdaptation::new(
+                    &params.csf,
+                    band_frequency(ppd, k),
+                    fitted::REFERENCE_LUMINANCE,
+                )
+            })
+            .collect();
+        Vdp {
+            ppd,
+            display,
+            params,
+            max_levels,
+            adaptation,
+            filters: Arc::default(),
+        }
+    }
+
+    /// Pixels per degree.
+    pub fn ppd(&self) -> f64 {
+        self.ppd
+    }
+
+    /// The parameters.
+    pub fn params(&self) -> &VdpParams {
+        &self.params
     }
 
     /// Centre frequency of band `k`, cycles per degree.
     pub fn band_frequency(&self, k: usize) -> f64 {
-        0.375 * self.ppd / (1u64 << k) as f64
+        band_frequency(self.ppd, k)
     }
 
-    /// CSF weight of band `k` (1 at the CSF's peak frequency).
-    fn band_weight(&self, k: usize) -> f32 {
-        (daly_rushmeier(self.band_frequency(k)) / self.csf_peak) as f32
+    /// The CSF filter for `w × h` images (from the cache, or made and cached).
+    fn filter(&self, w: usize, h: usize) -> Arc<CsfFilter> {
+        let mut cache = self.filters.lock().unwrap_or_else(|e| e.into_inner());
+        if let Some(i) = cache.iter().position(|f| f.fits(w, h, self.ppd)) {
+            let f = cache.remove(i);
+            cache.push(f.clone());
+            return f;
+        }
+        let f = Arc::new(CsfFilter::new(
+            w,
+            h,
+            self.ppd,
+            &self.params.csf,
+            fitted::REFERENCE_LUMINANCE,
+        ));
+        if cache.len() >= FILTER_CACHE {
+            cache.remove(0);
+        }
+        cache.push(f.clone());
+        f
     }
 
-    /// Stages 1–2 for one image.
+    /// Stages 1–5 for one image.
     pub fn prepare(&self, image: &LinearImage) -> VdpPrepared {
-        let r = amplitude::response(image, &self.display);
-        let plane = Plane {
-            w: image.width(),
-            h: image.height(),
-            v: r,
+        let l = image
+            .pixels()
+            .par_iter()
+            .map(|&c| self.display.luminance(luminance(c)))
+            .collect();
+        self.prepare_luminance(image.width(), image.height(), l)
+    }
+
+    /// Stages 2–5 for an image given as luminance in cd/m² (row-major, `w × h`, every value
+    /// finite and positive): stimuli specified in luminance, such as ModelFest's.
+    pub fn prepare_luminance(&self, w: usize, h: usize, luminance: Vec<f32>) -> VdpPrepared {
+        assert_eq!(luminance.len(), w * h, "one luminance per pixel");
+        let lum = Plane { w, h, v: luminance };
+        // Stage 1's logarithm (Weber contrast), then the CSF filter.
+        let log = Plane {
+            w,
+            h,
+            v: lum
+                .v
+                .par_iter()
+                .map(|&l| l.max(adaptation::L_MIN as f32).ln())
+                .collect(),
         };
+        let filtered = self.filter(w, h).apply(&log);
+        let (mut bands, mut residual) = bands::laplacian(&filtered, self.max_levels);
+        // Local adaptation from the Gaussian pyramid of luminance, one level below each band.
+        let gauss = bands::gaussian(&lum, bands.len() + 1);
+        for (k, band) in bands.iter_mut().enumerate() {
+            self.adaptation[k].apply(band, &gauss[k + 1]);
+        }
+        let k = bands.len();
+        self.adaptation[k].apply(&mut residual, &gauss[k + 1]);
+        let maskers = bands
+            .iter()
+            .map(|b| masking::local_magnitude(&b.v, b.w, b.h))
+            .collect();
         VdpPrepared {
-            width: image.width(),
-            height: image.height(),
-            bands: bands::decompose(&plane, self.max_levels),
+            width: w,
+            height: h,
+            bands,
+            maskers,
+            residual,
         }
     }
 
-    /// CSF-weighted channel responses (JND) of band `k` of an image: one vector per orientation.
-    ///
-    /// `weights` are the orientation weights to split by. A comparison splits both images by the
-    /// weights of their mean band: the cos² tuning comes from the local gradient direction, which
-    /// is ill-conditioned at the extrema of a band (gradient ≈ 0, value large), so splitting each
-    /// image by its own weights could put one large value into different orientations in two
-    /// nearly equal images and show a several-JND "difference" where there is almost none
-    /// (seen on 40-pixel renders of a LOD: 5.3 JND from one band sample, 0.25 JND without it).
-    fn channels(
-        &self,
-        band: &Band,
-        weights: &[[f32; ORIENTATIONS]],
-        k: usize,
-    ) -> [Vec<f32>; ORIENTATIONS] {
-        let w = self.band_weight(k);
-        std::array::from_fn(|c| {
-            band.plane
-                .v
-                .iter()
-                .zip(weights)
-                .map(|(v, wt)| v * wt[c] * w)
-                .collect()
-        })
-    }
-
-    /// Compare two prepared images.
+    /// Compare two prepared images (stages 5–7).
     pub fn compare_prepared(
         &self,
         reference: &VdpPrepared,
@@ -165,57 +286,41 @@ impl Vdp {
             (test.width, test.height),
         )?;
         let (w, h) = (reference.width, reference.height);
-        let beta = BETA;
-        let mut pixel_sum = vec![0.0f64; w * h];
-        let mut total = 0.0f64;
-        for (k, (rb, tb)) in reference.bands.iter().zip(&test.bands).enumerate() {
-            let (bw, bh) = (rb.plane.w, rb.plane.h);
-            let mean = bands::Plane {
-                w: bw,
-                h: bh,
-                v: rb
-                    .plane
-                    .v
-                    .iter()
-                    .zip(&tb.plane.v)
-                    .map(|(a, b)| 0.5 * (a + b))
-                    .collect(),
-            };
-            let weights = bands::orientation_weights(&mean);
-            let (rc, tc) = (
-                self.channels(rb, &weights, k),
-                self.channels(tb, &weights, k),
-            );
-            // Σ_c d_c^β per band sample (stages 4–5).
-            let mut sample_sum = vec![0.0f64; bw * bh];
-            for c in 0..ORIENTATIONS {
-                let mr = masking::local_magnitude(&rc[c], bw, bh);
-                let mt = masking::local_magnitude(&tc[c], bw, bh);
-                sample_sum.par_iter_mut().enumerate().for_each(|(i, s)| {
-                    let elevation = threshold_elevation(mr[i].min(mt[i]));
-                    let d = (tc[c][i] - rc[c][i]).abs() / elevation;
-                    *s += (d as f64).powf(beta as f64);
-                });
-            }
-            total += sample_sum.iter().sum::<f64>();
-            // Spread over the full-resolution pixels, interpolating bilinearly between band samples
-            // (nearest-neighbour spreading draws the coarse bands as visible blocks).
-            pixel_sum
-                .par_chunks_mut(w)
-                .enumerate()
-                .for_each(|(y, row)| {
-                    for (x, p) in row.iter_mut().enumerate() {
-                        *p += bilinear(&sample_sum, bw, bh, x, y, k);
-                    }
-                });
-        }
-        let map = pixel_sum
-            .iter()
-            .map(|&s| psychometric::probability(s) as f32)
+        // Stage 5: masked band differences.
+        let masked: Vec<Plane> = (0..reference.bands.len())
+            .map(|k| {
+                let (rb, tb) = (&reference.bands[k], &test.bands[k]);
+                let (mr, mt) = (&reference.maskers[k], &test.maskers[k]);
+                let v = (0..rb.v.len())
+                    .into_par_iter()
+                    .map(|i| (tb.v[i] - rb.v[i]) / threshold_elevation(mr[i].min(mt[i])))
+                    .collect();
+                Plane {
+                    w: rb.w,
+                    h: rb.h,
+                    v,
+                }
+            })
             .collect();
+        let residual = Plane {
+            w: reference.residual.w,
+            h: reference.residual.h,
+            v: reference
+                .residual
+                .v
+                .iter()
+                .zip(&test.residual.v)
+                .map(|(r, t)| t - r)
+                .collect(),
+        };
+        // Stage 6: one difference image, pooled over visual angle.
+        let d = bands::collapse(masked, residual);
+        let (sum, density) = pooling::minkowski(&d, self.ppd, self.params.beta);
+        let map = pooling::probability_map(&density, w, h, self.ppd);
+        // Stage 7.
         Ok(VdpScore {
-            probability: psychometric::probability(total),
-            jnd: psychometric::jnd(total),
+            probability: psychometric::probability(sum),
+            jnd: psychometric::jnd(sum, self.params.beta),
             map: ErrorMap {
                 width: w,
                 height: h,
@@ -231,23 +336,19 @@ impl Vdp {
     }
 
     /// How strongly an image's own content masks errors (Qu & Meyer §4.2): per pixel the largest
-    /// threshold elevation (≥ 1) over bands and orientations, 1 meaning no masking.
+    /// threshold elevation (≥ 1) over bands, 1 meaning no masking.
     pub fn masking_map(&self, image: &LinearImage) -> ErrorMap {
         let p = self.prepare(image);
         let (w, h) = (p.width, p.height);
         let mut out = vec![1.0f32; w * h];
-        for (k, band) in p.bands.iter().enumerate() {
-            let (bw, bh) = (band.plane.w, band.plane.h);
-            let ch = self.channels(band, &band.weights, k);
-            for c in ch.iter() {
-                let m = masking::local_magnitude(c, bw, bh);
-                out.par_chunks_mut(w).enumerate().for_each(|(y, row)| {
-                    let by = (y >> k).min(bh - 1);
-                    for (x, o) in row.iter_mut().enumerate() {
-                        *o = o.max(threshold_elevation(m[by * bw + (x >> k).min(bw - 1)]));
-                    }
-                });
-            }
+        for (k, (band, m)) in p.bands.iter().zip(&p.maskers).enumerate() {
+            let (bw, bh) = (band.w, band.h);
+            out.par_chunks_mut(w).enumerate().for_each(|(y, row)| {
+                let by = (y >> k).min(bh - 1);
+                for (x, o) in row.iter_mut().enumerate() {
+                    *o = o.max(threshold_elevation(m[by * bw + (x >> k).min(bw - 1)]));
+                }
+            });
         }
         ErrorMap {
             width: w,
@@ -255,4 +356,9 @@ impl Vdp {
             values: out,
         }
     }
+}
+
+/// Centre frequency of band `k` at `ppd`, cycles per degree.
+fn band_frequency(ppd: f64, k: usize) -> f64 {
+    0.375 * ppd / (1u64 << k) as f64
 }

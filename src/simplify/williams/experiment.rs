@@ -232,6 +232,7 @@ pub fn run(config: &Path, log: &mut dyn FnMut(&str)) -> Result<Vec<SummaryRow>> 
     let scorer = Scorer::new(
         &[MetricFamily::Flip, MetricFamily::Vdp],
         &Viewing::DEFAULT,
+        crate::metric::vdp::Display::DEFAULT,
         0.1,
     );
     let rig = Rig::parse(&exp.rig).expect("checked");

@@ -1,0 +1,67 @@
+//! Fits the VDP's four free constants (`src/metric/vdp/fitted.rs`) on ModelFest: Nelder–Mead on
+//! the RMS error of predicted against observed log10 contrast sensitivity over the 43 stimuli,
+//! each prediction the threshold search that `lodeval calibrate modelfest` runs. Prints the fit;
+//! the values are then written into `fitted.rs` by hand (nothing is fitted at run time).
+//!
+//! Run from the repository root: `cargo run --release --example fit_vdp [-- --evals N]`.
+//! Parameters are searched as (ln P, ε, ob, β) from the current constants.
+
+use std::path::Path;
+
+use lodeval::metric::csf::DalyCsf;
+use lodeval::metric::vdp::modelfest::{Condition, ModelFest, calibrate};
+use lodeval::metric::vdp::{VdpParams, fitted};
+use lodeval::simplify::lindstrom_turk::simplex::minimize;
+
+fn params(x: &[f64]) -> Option<VdpParams> {
+    VdpParams::new(DalyCsf::new(x[0].exp(), x[1], x[2])?, x[3])
+}
+
+fn main() {
+    let evals: usize = std::env::args()
+        .skip_while(|a| a != "--evals")
+        .nth(1)
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(200);
+    let data = ModelFest::load(Path::new("reference/oracles/modelfest")).expect("oracle folder");
+    let rmse = |x: &[f64]| -> f64 {
+        match params(x) {
+            Some(p) => calibrate(&data, p, Condition::MODELFEST)
+                .map(|c| c.rmse_log10)
+                .unwrap_or(f64::INFINITY),
+            None => f64::INFINITY,
+        }
+    };
+    let mut x = vec![
+        fitted::PEAK_SENSITIVITY.ln(),
+        fitted::FREQUENCY_SCALE,
+        fitted::OBLIQUE,
+        fitted::BETA,
+    ];
+    let mut fx = rmse(&x);
+    eprintln!("start {x:?}: RMSE {fx:.5}");
+    // Restart the simplex from its best point until a restart no longer improves the fit.
+    let mut steps = vec![0.05, 0.05, 0.05, 0.1];
+    for round in 0..8 {
+        let m = minimize(&x, fx, &steps, evals, &rmse);
+        eprintln!(
+            "round {round}: RMSE {:.5} at {:?} ({} evaluations)",
+            m.value, m.point, m.evals
+        );
+        let gain = fx - m.value;
+        x = m.point;
+        fx = m.value;
+        if gain < 1e-5 {
+            break;
+        }
+        steps.iter_mut().for_each(|s| *s *= 0.5);
+    }
+    println!(
+        "P = {:.4}, epsilon = {:.5}, ob = {:.5}, beta = {:.5}: RMSE {:.5} log10",
+        x[0].exp(),
+        x[1],
+        x[2],
+        x[3],
+        fx
+    );
+}
