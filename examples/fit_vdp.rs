@@ -3,8 +3,9 @@
 //! each prediction the threshold search that `lodeval calibrate modelfest` runs. Prints the fit;
 //! the values are then written into `fitted.rs` by hand (nothing is fitted at run time).
 //!
-//! Run from the repository root: `cargo run --release --example fit_vdp [-- --evals N]`.
-//! Parameters are searched as (ln P, ε, ob, β) from the current constants.
+//! Run from the repository root: `cargo run --release --example fit_vdp [-- --evals N]
+//! [--from-published]`. Parameters are searched as (ln P, ε, ob, β), from the current constants or
+//! from Daly's published ones (P = 250, ε = 0.9, ob = 0.78, β = 3.5).
 
 use std::path::Path;
 
@@ -32,17 +33,21 @@ fn main() {
             None => f64::INFINITY,
         }
     };
-    let mut x = vec![
-        fitted::PEAK_SENSITIVITY.ln(),
-        fitted::FREQUENCY_SCALE,
-        fitted::OBLIQUE,
-        fitted::BETA,
-    ];
+    let mut x = if std::env::args().any(|a| a == "--from-published") {
+        vec![250f64.ln(), 0.9, 0.78, 3.5]
+    } else {
+        vec![
+            fitted::PEAK_SENSITIVITY.ln(),
+            fitted::FREQUENCY_SCALE,
+            fitted::OBLIQUE,
+            fitted::BETA,
+        ]
+    };
     let mut fx = rmse(&x);
     eprintln!("start {x:?}: RMSE {fx:.5}");
     // Restart the simplex from its best point until a restart no longer improves the fit.
     let mut steps = vec![0.05, 0.05, 0.05, 0.1];
-    for round in 0..8 {
+    for round in 0..20 {
         let m = minimize(&x, fx, &steps, evals, &rmse);
         eprintln!(
             "round {round}: RMSE {:.5} at {:?} ({} evaluations)",

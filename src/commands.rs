@@ -367,6 +367,15 @@ pub struct DiffResult {
     pub backend: String,
 }
 
+/// Where and on what the compared images are seen.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Seen {
+    /// The viewer's geometry (pixels per degree).
+    pub viewing: crate::scene::Viewing,
+    /// The display (the VDP's luminance model).
+    pub display: crate::metric::vdp::Display,
+}
+
 /// Compare two image files with the given metrics; writes magma heat maps if `map` is given
 /// (`map` itself for one metric with a map, `STEM-METRIC.png` beside it for several). With
 /// `lenient`, a metric that does not apply to images of this size (SSIM below 11×11, MS-SSIM
@@ -376,7 +385,7 @@ pub fn diff(
     reference: &Path,
     test: &Path,
     metrics: &[DiffMetric],
-    viewing: &crate::scene::Viewing,
+    seen: &Seen,
     map: Option<&Path>,
     lenient: bool,
 ) -> Result<Vec<DiffResult>> {
@@ -396,11 +405,13 @@ pub fn diff(
             "compare images of the same size",
         ));
     }
+    let viewing = &seen.viewing;
+    let vdp = crate::metric::vdp::Vdp::checked(viewing, seen.display)?;
     let ppd = viewing.ppd();
     let (w, h) = (a.width(), a.height());
     let with_maps = metrics
         .iter()
-        .filter(|m| matches!(m, DiffMetric::Flip | DiffMetric::Ssim))
+        .filter(|m| matches!(m, DiffMetric::Flip | DiffMetric::Ssim | DiffMetric::Vdp))
         .count();
     let map_path = |metric: DiffMetric| -> Option<PathBuf> {
         let p = map?;
@@ -485,9 +496,7 @@ pub fn diff(
                 }
                 DiffMetric::Mse => r.value = Some(engine.mse(&a, &b)?.mse),
                 DiffMetric::Vdp => {
-                    let s =
-                        crate::metric::vdp::Vdp::new(viewing, crate::metric::vdp::Display::DEFAULT)
-                            .compare(&a, &b)?;
+                    let s = vdp.compare(&a, &b)?;
                     r.value = Some(s.probability);
                     r.jnd = Some(s.jnd);
                     if let Some(path) = map_path(metric) {

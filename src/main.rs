@@ -190,7 +190,20 @@ struct DiffArgs {
     /// Viewing distance in metres.
     #[arg(long, default_value_t = 0.7)]
     distance_m: f64,
-    /// Write a magma heat map of the error here (FLIP error, or 1 − SSIM).
+    /// VDP display model: luminance of white, cd/m².
+    #[arg(long, default_value_t = 100.0)]
+    peak_cd_m2: f32,
+    /// VDP display model: luminance of black in a dark room, cd/m².
+    #[arg(long, default_value_t = 0.5)]
+    black_cd_m2: f32,
+    /// VDP display model: room light on the screen, lux.
+    #[arg(long, default_value_t = 250.0)]
+    ambient_lux: f32,
+    /// VDP display model: fraction of the room light the screen reflects.
+    #[arg(long, default_value_t = 0.005)]
+    reflectivity: f32,
+    /// Write a magma heat map of the error here (FLIP error, 1 − SSIM, or the VDP's detection
+    /// probability).
     #[arg(long)]
     map: Option<PathBuf>,
     /// Print JSON (an array, one object per metric).
@@ -633,12 +646,18 @@ fn run(cli: Cli) -> Result<(), Error> {
             // With `all`, metrics that do not apply to this image size report a note instead.
             let lenient = a.metric == "all";
             let engine = lodeval::backend::Engine::new(a.backend.into())?;
+            let display = lodeval::metric::vdp::Display::new(
+                a.peak_cd_m2,
+                a.black_cd_m2,
+                a.ambient_lux,
+                a.reflectivity,
+            )?;
             let results = lodeval::commands::diff(
                 &engine,
                 &a.reference,
                 &a.test,
                 &metrics,
-                &viewing,
+                &lodeval::commands::Seen { viewing, display },
                 a.map.as_deref(),
                 lenient,
             )?;

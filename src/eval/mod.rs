@@ -207,7 +207,7 @@ fn copy_tree(from: &Path, to: &Path) -> Result<()> {
 pub fn summary_table(outcome: &Outcome) -> String {
     let r = &outcome.results;
     let mut s = format!(
-        "{:<12} {:<16} {:>9} {:>7} {:>9} {:>9} {:>8} {:>8} {:>10}  gate\n",
+        "{:<12} {:<16} {:>9} {:>7} {:>9} {:>9} {:>8} {:>8} {:>8} {:>10} {:>10}  gate\n",
         "asset",
         "lod",
         "triangles",
@@ -216,7 +216,9 @@ pub fn summary_table(outcome: &Outcome) -> String {
         "flip_max",
         "psnr_min",
         "vdp_max",
-        "visible_m"
+        "jnd_max",
+        "visible_m",
+        "visible_px"
     );
     let fmt = |v: Option<f64>, d: usize| match v {
         Some(x) if x.is_finite() => format!("{x:.d$}"),
@@ -225,19 +227,21 @@ pub fn summary_table(outcome: &Outcome) -> String {
     };
     for l in &r.lods {
         let hl = r.headline(&l.asset, &l.lod);
-        let dist = hl.distance.as_ref().map(|d| {
-            format!(
-                "{}{:.2}",
-                if d.resolved { "" } else { "~" },
-                d.imperceptible_beyond_m
-            )
-        });
+        let bound = |d: &tables::DistanceRow| if d.resolved { "" } else { "~" };
+        let dist = hl
+            .distance
+            .as_ref()
+            .map(|d| format!("{}{:.2}", bound(d), d.imperceptible_beyond_m));
+        let px = hl
+            .distance
+            .as_ref()
+            .map(|d| format!("{}{:.0}", bound(d), d.diameter_px));
         let failed = outcome
             .failures
             .iter()
             .any(|f| f.asset == l.asset && f.lod == l.lod);
         s.push_str(&format!(
-            "{:<12} {:<16} {:>9} {:>7.4} {:>9} {:>9} {:>8} {:>8} {:>10}  {}\n",
+            "{:<12} {:<16} {:>9} {:>7.4} {:>9} {:>9} {:>8} {:>8} {:>8} {:>10} {:>10}  {}\n",
             l.asset,
             l.lod,
             l.triangles,
@@ -246,7 +250,9 @@ pub fn summary_table(outcome: &Outcome) -> String {
             fmt(hl.flip_worst, 4),
             fmt(hl.psnr_worst, 2),
             fmt(hl.vdp_worst, 3),
+            fmt(hl.vdp_jnd_worst, 2),
             dist.unwrap_or_else(|| "-".into()),
+            px.unwrap_or_else(|| "-".into()),
             if failed { "FAIL" } else { "pass" }
         ));
     }

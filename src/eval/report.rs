@@ -93,14 +93,14 @@ pub fn render(plan: &Plan, results: &Results, failures: &[Failure]) -> String {
             esc(&asset.name),
             esc(&asset.mesh.display().to_string())
         );
-        h.push_str("<table><tr><th>LOD</th><th>triangles</th><th>ratio</th><th>FLIP mean</th><th>FLIP worst view</th><th>SSIM worst</th><th>PSNR worst (dB)</th><th>VDP p worst</th><th>imperceptible beyond (m)</th><th>Unity screen height</th><th>engine switch (m)</th><th>gate</th></tr>\n");
+        h.push_str("<table><tr><th>LOD</th><th>triangles</th><th>ratio</th><th>FLIP mean</th><th>FLIP worst view</th><th>SSIM worst</th><th>PSNR worst (dB)</th><th>VDP p worst</th><th>VDP JND worst</th><th>imperceptible beyond (m)</th><th>visible above (px)</th><th>Unity screen height</th><th>engine switch (m)</th><th>gate</th></tr>\n");
         for l in &lods {
             let hl = results.headline(&asset.name, &l.lod);
             let dist: Option<&DistanceRow> = hl.distance.as_ref();
             let bad = failing.contains(&(asset.name.as_str(), l.lod.as_str()));
             let _ = writeln!(
                 h,
-                "<tr class=\"{}\"><td>{}</td><td>{}</td><td>{:.4}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}{}</td><td>{}</td><td>{}</td><td>{}</td></tr>",
+                "<tr class=\"{}\"><td>{}</td><td>{}</td><td>{:.4}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td></tr>",
                 if bad { "fail" } else { "pass" },
                 esc(&l.lod),
                 l.triangles,
@@ -110,12 +110,14 @@ pub fn render(plan: &Plan, results: &Results, failures: &[Failure]) -> String {
                 num(hl.ssim_worst, 4),
                 num(hl.psnr_worst, 2),
                 num(hl.vdp_worst, 3),
+                num(hl.vdp_jnd_worst, 2),
                 num(dist.map(|d| d.imperceptible_beyond_m), 2),
                 if dist.is_some_and(|d| !d.resolved) {
                     " (bound)"
                 } else {
                     ""
                 },
+                num(dist.map(|d| d.diameter_px), 0),
                 num(dist.map(|d| d.screen_height_fraction), 4),
                 num(l.switch_m, 2),
                 if bad { "FAIL" } else { "pass" }

@@ -161,6 +161,8 @@ pub struct Headline {
     pub psnr_worst: Option<f64>,
     /// VDP detection probability of the worst view.
     pub vdp_worst: Option<f64>,
+    /// VDP difference of the worst view, JND.
+    pub vdp_jnd_worst: Option<f64>,
     /// The VDP-criterion distance row.
     pub distance: Option<DistanceRow>,
 }
@@ -283,6 +285,7 @@ impl Results {
             ssim_worst: worst("ssim"),
             psnr_worst: worst("psnr"),
             vdp_worst: worst("vdp"),
+            vdp_jnd_worst: worst("vdp_jnd"),
             distance: self
                 .distances
                 .iter()

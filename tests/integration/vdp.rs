@@ -15,7 +15,7 @@ use lodeval::metric::LinearImage;
 use lodeval::metric::csf::daly_rushmeier;
 use lodeval::metric::vdp::modelfest::{Condition, ModelFest, calibrate};
 use lodeval::metric::vdp::{Display, Vdp, VdpParams};
-use lodeval::raster::{self, RenderSettings, SamplePattern, with_threads};
+use lodeval::raster::{self, RenderSettings, with_threads};
 use lodeval::scene::{Rig, Scene, Viewing};
 use lodeval::simplify::{Goal, Method, chain};
 
@@ -279,8 +279,15 @@ fn calibrate_refuses_a_missing_or_damaged_oracle_and_nonsense_conditions() {
         }
         d
     };
-    let table = |d: &std::path::Path| std::fs::read_to_string(d.join("thresholds.csv")).unwrap();
-    let cases: Vec<(&str, Box<dyn Fn(&std::path::Path)>, &str)> = vec![
+    type Damage = Box<dyn Fn(&std::path::Path)>;
+    // Rewrite thresholds.csv through `f`.
+    let edit_table = |f: fn(String) -> String| -> Damage {
+        Box::new(move |d| {
+            let t = std::fs::read_to_string(d.join("thresholds.csv")).unwrap();
+            std::fs::write(d.join("thresholds.csv"), f(t)).unwrap();
+        })
+    };
+    let cases: Vec<(&str, Damage, &str)> = vec![
         (
             "truncated-png",
             Box::new(|d| {
@@ -306,26 +313,17 @@ fn calibrate_refuses_a_missing_or_damaged_oracle_and_nonsense_conditions() {
         ),
         (
             "nan-threshold",
-            Box::new(move |d| {
-                let t = table(d).replace("1.8210", "NaN");
-                std::fs::write(d.join("thresholds.csv"), t).unwrap();
-            }),
+            edit_table(|t| t.replace("1.8210", "NaN")),
             "line 2",
         ),
         (
             "short-table",
-            Box::new(move |d| {
-                let t: Vec<String> = table(d).lines().take(30).map(str::to_string).collect();
-                std::fs::write(d.join("thresholds.csv"), t.join("\n")).unwrap();
-            }),
+            edit_table(|t| t.lines().take(30).collect::<Vec<_>>().join("\n")),
             "29 stimuli",
         ),
         (
             "path-in-table",
-            Box::new(move |d| {
-                let t = table(d).replace("02-GaborPatch2.png", "../../etc/passwd");
-                std::fs::write(d.join("thresholds.csv"), t).unwrap();
-            }),
+            edit_table(|t| t.replace("02-GaborPatch2.png", "../../etc/passwd")),
             "line 3",
         ),
         (

@@ -106,7 +106,12 @@ impl Display {
     pub fn luminance(&self, linear: f32) -> f32 {
         self.black_cd_m2
             + self.reflected_cd_m2()
-            + (self.peak_cd_m2 - self.black_cd_m2) * linear.max(0.0).min(1.0)
+            + (self.peak_cd_m2 - self.black_cd_m2)
+                * if linear.is_nan() {
+                    0.0
+                } else {
+                    linear.clamp(0.0, 1.0)
+                }
     }
 
     /// The linear value this display shows as `cd_m2` (outside [0, 1] when out of its range): puts

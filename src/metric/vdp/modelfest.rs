@@ -19,7 +19,7 @@
 //! S grows about as c^β, so ln S is nearly linear in ln c and a few steps reach |ln S| < 10⁻⁶.
 //! The predicted log10 sensitivity is −log10 c.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use rayon::prelude::*;
 
@@ -267,7 +267,7 @@ impl ModelFest {
 }
 
 /// A stimulus PNG → s ∈ [−1, 1].
-fn load_pattern(path: &PathBuf) -> Result<Vec<f32>> {
+fn load_pattern(path: &Path) -> Result<Vec<f32>> {
     let fix = "regenerate it with reference/oracles/modelfest/make_modelfest.py";
     let bytes = read_small(path, "stimulus image")?;
     let img = image::load_from_memory_with_format(&bytes, image::ImageFormat::Png)
