@@ -2,7 +2,7 @@
 //! that distance in each engine's own LOD parameter.
 //!
 //! Geometry. The display is a window of `display_px` × `display_height_px` pixels, `display_width_m`
-//! wide, seen from `distance_m` (DESIGN.md's viewing conditions). A pixel at the centre subtends
+//! wide, seen from `distance_m` (the default viewing conditions). A pixel at the centre subtends
 //! 1/k radians with k = distance_m · display_px / display_width_m, which also fixes the engine
 //! camera's vertical field of view (cot(fov/2) = 2k / height_px). An object whose bounding sphere
 //! has radius R (metres) at distance D from the eye projects to a disc of diameter

@@ -7,9 +7,9 @@
 //! light, L_refl = k·E_amb/π for a screen of reflectivity k under E_amb lux (a Lambertian
 //! reflector), which adds to every pixel.
 //!
-//! Decision (DESIGN.md is silent on the display): the defaults are an office monitor in an office,
+//! Decision (the papers leave the display open): the defaults are an office monitor in an office,
 //! 100 cd/m² white, 0.5 cd/m² black, 250 lux of ambient light on a matte screen of reflectivity
-//! 0.5 % (0.4 cd/m² reflected). The rendered images are linear light already (DESIGN.md's
+//! 0.5 % (0.4 cd/m² reflected). The rendered images are linear light already (the
 //! colour contract), so the display applies no transfer function of its own: `v` is the linear
 //! value an sRGB display would produce from the encoded pixel.
 //!
