@@ -7,11 +7,12 @@
 //! backend renders; scores are computed on the CPU. `diff` runs FLIP, MSE and PSNR on it.
 
 use crate::error::Result;
-use crate::metric::LinearImage;
+use crate::image::LinearImage;
 use crate::metric::flip::{Flip, FlipScore};
 use crate::metric::mse::MseScore;
+use crate::raster::RenderScene;
 use crate::raster::{self, Frame, RenderSettings};
-use crate::scene::{Camera, Scene};
+use crate::scene::Camera;
 
 /// The user's choice.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -108,7 +109,7 @@ impl Engine {
     }
 
     /// Make `scene` renderable (uploads it for the GPU).
-    pub fn scene<'a>(&self, scene: &'a Scene) -> Result<SceneRenderer<'a>> {
+    pub fn scene<'a>(&self, scene: &'a RenderScene) -> Result<SceneRenderer<'a>> {
         #[cfg(feature = "gpu")]
         if let Some((gpu, _)) = &self.gpu {
             return Ok(SceneRenderer::Gpu(Box::new(crate::gpu::GpuScene::new(
@@ -148,7 +149,7 @@ impl Engine {
 #[non_exhaustive]
 pub enum SceneRenderer<'a> {
     /// The CPU rasterizer.
-    Cpu(&'a Scene),
+    Cpu(&'a RenderScene),
     /// Uploaded to the GPU.
     #[cfg(feature = "gpu")]
     Gpu(Box<crate::gpu::GpuScene>),

@@ -7,7 +7,7 @@ use std::sync::Arc;
 
 use crate::error::{Error, Result};
 use crate::mesh::{self, LoadOptions, Mesh};
-use crate::raster::{self, Frame, RenderSettings};
+use crate::raster::{self, Frame, RenderScene, RenderSettings};
 use crate::scene::{Camera, Rig, Scene};
 
 /// Which views `lodeval render` writes.
@@ -51,22 +51,6 @@ pub struct RenderJob {
     pub backend: crate::backend::Backend,
 }
 
-/// Cameras for every view of `rig`, each framing the mesh's bounding sphere.
-pub fn rig_cameras(mesh: &Mesh, rig: &Rig, aspect: f32) -> Vec<Camera> {
-    rig.directions()
-        .into_iter()
-        .map(|d| {
-            Camera::frame_sphere(
-                mesh.bounding_sphere(),
-                d,
-                Camera::DEFAULT_FOV_Y_DEG,
-                aspect,
-                Camera::DEFAULT_MARGIN,
-            )
-        })
-        .collect()
-}
-
 fn write_frame(path: &Path, frame: &Frame, exr: bool) -> Result<()> {
     crate::io::write_image(path, &image::DynamicImage::ImageRgb8(frame.to_srgb8()))?;
     if exr {
@@ -81,9 +65,9 @@ fn write_frame(path: &Path, frame: &Frame, exr: bool) -> Result<()> {
 /// Run a render job; returns the files written.
 pub fn render(job: &RenderJob) -> Result<Vec<PathBuf>> {
     let mesh = Arc::new(mesh::load(&job.mesh, &job.load)?);
-    let scene = Scene::new(mesh.clone());
+    let scene = RenderScene::of(mesh.clone());
     let aspect = job.settings.width as f32 / job.settings.height as f32;
-    let cameras = rig_cameras(&mesh, &job.rig, aspect);
+    let cameras = job.rig.cameras(&mesh, aspect);
     let engine = crate::backend::Engine::new(job.backend)?;
     let renderer = engine.scene(&scene)?;
     let mut written = Vec::new();
@@ -171,8 +155,8 @@ pub struct RasterBenchRow {
 /// asserts on it.
 pub fn bench_raster(b: &RasterBench) -> Result<Vec<RasterBenchRow>> {
     let mesh = Arc::new(crate::mesh::shapes::torus(b.rings, b.sides, 0.35));
-    let scene = Scene::new(mesh.clone());
-    let cameras = rig_cameras(&mesh, &Rig::Fibonacci(b.views), 1.0);
+    let scene = RenderScene::of(mesh.clone());
+    let cameras = Rig::Fibonacci(b.views).cameras(&mesh, 1.0);
     if let Some(dir) = &b.export {
         export_scene(dir, &scene, &cameras)?;
         // View 0 at 1 sample, to compare pictures with the other renderer's.
@@ -709,9 +693,9 @@ pub fn simplify_williams(job: &WilliamsJob) -> Result<Vec<SimplifyRow>> {
         ..Options::default()
     };
     let cameras = match &job.views {
-        WilliamsViews::All(rig) => rig_cameras(&mesh, rig, 1.0),
+        WilliamsViews::All(rig) => rig.cameras(&mesh, 1.0),
         WilliamsViews::One(rig, k) => {
-            let cams = rig_cameras(&mesh, rig, 1.0);
+            let cams = rig.cameras(&mesh, 1.0);
             vec![*cams.get(*k).ok_or_else(|| {
                 Error::Usage(format!("--view {k}: the rig has views 0..{}", cams.len()))
             })?]
@@ -784,7 +768,7 @@ pub fn bench_williams(mesh: &Mesh, ratios: &[f64], views: u32) -> Result<Vec<Wil
             glam::Vec3::new(a.sin(), 0.3, a.cos()).normalize()
         })
         .collect();
-    let cameras = rig_cameras(mesh, &Rig::Explicit(orbit), 1.0);
+    let cameras = Rig::Explicit(orbit).cameras(mesh, 1.0);
     let opts = Options::default();
     let mut rows = Vec::new();
     for &r in ratios {

@@ -23,12 +23,14 @@
 #![warn(missing_docs, missing_debug_implementations)]
 
 pub mod backend;
+pub mod color;
 pub mod commands;
 pub mod cpu;
 pub mod error;
 pub mod eval;
 #[cfg(feature = "gpu")]
 pub mod gpu;
+pub mod image;
 pub mod io;
 pub mod mesh;
 pub mod metric;

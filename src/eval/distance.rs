@@ -37,11 +37,11 @@ use glam::Vec3;
 use super::config::{DistanceConfig, ViewingConfig};
 use super::tables::{DistanceRow, round7};
 use crate::error::Result;
-use crate::metric::LinearImage;
+use crate::image::LinearImage;
 use crate::metric::flip::Flip;
 use crate::metric::vdp::Vdp;
-use crate::raster::{self, RenderSettings, SamplePattern};
-use crate::scene::{Camera, Projection, Scene};
+use crate::raster::{self, RenderScene, RenderSettings, SamplePattern};
+use crate::scene::{Camera, Projection};
 
 /// The display geometry used to convert between distances and pixels.
 #[derive(Debug, Clone, Copy)]
@@ -98,9 +98,9 @@ const MIN_PROBE: u32 = 4;
 #[derive(Debug)]
 pub struct DistanceJob<'a> {
     /// The original.
-    pub original: &'a Scene,
+    pub original: &'a RenderScene,
     /// The LOD.
-    pub lod: &'a Scene,
+    pub lod: &'a RenderScene,
     /// View directions to test (the worst views first).
     pub directions: Vec<Vec3>,
     /// Metres per model unit.

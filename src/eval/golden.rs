@@ -64,7 +64,7 @@ pub fn run(plan: &Plan, bless: bool, ci: bool, out_dir: &Path) -> Result<GoldenO
     let mut outcome = GoldenOutcome::default();
     for asset in &plan.assets {
         let original = Arc::new(mesh::load(&asset.mesh, &LoadOptions::default())?);
-        let cameras = crate::commands::rig_cameras(&original, &cfg.render.rig.0, 1.0);
+        let cameras = cfg.render.rig.0.cameras(&original, 1.0);
         let mut meshes: Vec<(String, Arc<Mesh>)> = vec![("original".into(), original.clone())];
         if cfg.golden.lods {
             let all = vec![true; asset.lods.len()];

@@ -27,7 +27,7 @@ use super::tables::{LodInfo, MetricRow, Results, higher_is_worse, round7};
 use crate::error::Result;
 use crate::mesh::{self, LoadOptions, Mesh, surface_distance};
 use crate::metric::{LinearImage, colormap};
-use crate::raster;
+use crate::raster::{self, RenderScene};
 use crate::scene::Scene;
 use crate::simplify::{self, Method};
 
@@ -58,7 +58,7 @@ pub struct RunOutput {
 /// A LOD ready to render.
 struct LodScene {
     name: String,
-    scene: Scene,
+    scene: RenderScene,
     info: LodInfo,
 }
 
@@ -126,7 +126,7 @@ pub fn run(plan: Plan, options: &RunOptions) -> Result<RunOutput> {
                 }
             })
             .collect::<Vec<_>>();
-        let cameras = crate::commands::rig_cameras(&original, &cfg.render.rig.0, 1.0);
+        let cameras = cfg.render.rig.0.cameras(&original, 1.0);
         let reference_renderer = engine.scene(&reference)?;
         let lod_renderers = lods
             .iter()
@@ -245,13 +245,13 @@ pub fn run(plan: Plan, options: &RunOptions) -> Result<RunOutput> {
 }
 
 /// A scene of `mesh` with the config's lights, background and ambient term.
-pub fn scene_for(cfg: &super::config::Config, mesh: Arc<Mesh>) -> Scene {
+pub fn scene_for(cfg: &super::config::Config, mesh: Arc<Mesh>) -> RenderScene {
     let mut s = Scene::new(mesh);
     s.lights = cfg.render.scene_lights();
     s.background = glam::Vec3::from_array(cfg.render.background.map(|c| c.0 as f32))
-        .map(crate::metric::color::srgb_to_linear);
+        .map(crate::color::srgb_to_linear);
     s.ambient = cfg.render.ambient.0 as f32;
-    s
+    RenderScene::new(s)
 }
 
 /// Load or generate the wanted LODs of an asset (a generated chain is built up to its last wanted
@@ -380,7 +380,7 @@ fn write_heat_map(
     lod: &str,
     view: usize,
     metric: &str,
-    map: &crate::metric::ErrorMap,
+    map: &crate::image::ErrorMap,
 ) -> Result<()> {
     let img = colormap::heat_map(&map.values, map.width, map.height, (map.height / 32).max(4));
     crate::io::write_image(

@@ -98,7 +98,7 @@ impl GpuMetrics {
 
     /// MSE, RMSE and PSNR, as [`crate::metric::mse::mse`].
     pub fn mse(&self, reference: &LinearImage, test: &LinearImage) -> Result<MseScore> {
-        crate::metric::image::same_size(reference, test)?;
+        crate::image::same_size(reference, test)?;
         let gpu = &self.gpu;
         gpu.checked("MSE", || {
             let (w, h) = (reference.width(), reference.height());
@@ -208,7 +208,7 @@ impl GpuMetrics {
         reference: &GpuFlipPrepared,
         test: &GpuFlipPrepared,
     ) -> Result<FlipScore> {
-        crate::metric::image::same_dims(
+        crate::image::same_dims(
             (reference.width, reference.height),
             (test.width, test.height),
         )?;
@@ -256,7 +256,7 @@ impl GpuMetrics {
         reference: &LinearImage,
         test: &LinearImage,
     ) -> Result<FlipScore> {
-        crate::metric::image::same_size(reference, test)?;
+        crate::image::same_size(reference, test)?;
         let a = self.flip_prepare(flip, reference)?;
         let b = self.flip_prepare(flip, test)?;
         self.flip_compare(flip, &a, &b)

@@ -1,4 +1,4 @@
-//! The GPU renderer: a [`Scene`] uploaded once, rendered from any camera into a [`Frame`].
+//! The GPU renderer: a [`RenderScene`] uploaded once, rendered from any camera into a [`Frame`].
 //!
 //! Upload (once per scene): one storage buffer of 16 floats per vertex (position, the vertex's
 //! material for Gouraud, normal, tangent handedness, UV, colour, tangent — absent attributes are
@@ -25,8 +25,9 @@ use glam::{Vec3, Vec4};
 
 use super::Gpu;
 use crate::error::{Error, Result};
+use crate::raster::RenderScene;
 use crate::raster::{Frame, RenderSettings, ResolvedLight, Shading, camera_setup};
-use crate::scene::{Camera, Scene};
+use crate::scene::Camera;
 
 const VISIBILITY_WGSL: &str = include_str!("shaders/visibility.wgsl");
 const SHADE_WGSL: &str = include_str!("shaders/shade.wgsl");
@@ -130,12 +131,12 @@ pub struct GpuScene {
 
 impl GpuScene {
     /// Upload `scene`.
-    pub fn new(gpu: Arc<Gpu>, scene: &Scene) -> Result<GpuScene> {
+    pub fn new(gpu: Arc<Gpu>, scene: &RenderScene) -> Result<GpuScene> {
         gpu.clone()
             .checked("uploading the scene", || Self::upload(gpu, scene))
     }
 
-    fn upload(gpu: Arc<Gpu>, scene: &Scene) -> Result<GpuScene> {
+    fn upload(gpu: Arc<Gpu>, scene: &RenderScene) -> Result<GpuScene> {
         let mesh = scene.mesh();
         let prepared = scene.prepared();
         let tri_count = mesh.triangles().len();

@@ -21,8 +21,8 @@ use glam::{Vec2, Vec3};
 
 use super::texture::{ColorSpace, TextureCache, resolve_asset_path};
 use super::{Format, LoadOptions, Material, MeshData, MissingAssets, Source, read_file};
+use crate::color::srgb_to_linear;
 use crate::error::{Error, Location, Result};
-use crate::metric::color::srgb_to_linear;
 
 const FIX_SYNTAX: &str = "fix or delete that line, or re-export the OBJ";
 

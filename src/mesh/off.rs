@@ -10,8 +10,8 @@ use std::path::Path;
 use glam::Vec3;
 
 use super::{Format, MeshData, Source, read_file};
+use crate::color::srgb_to_linear;
 use crate::error::{Error, Location, Result};
-use crate::metric::color::srgb_to_linear;
 
 const FIX: &str = "fix that line or re-export the OFF file";
 

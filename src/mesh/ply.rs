@@ -17,8 +17,8 @@ use ply_rs_bw::parser::Parser;
 use ply_rs_bw::ply::{DefaultElement, Property};
 
 use super::{Format, MeshData, Source, read_file};
+use crate::color::srgb_to_linear;
 use crate::error::{Error, Location, Result};
-use crate::metric::color::srgb_to_linear;
 
 const REEXPORT: &str = "re-export the PLY from its authoring tool";
 

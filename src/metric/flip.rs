@@ -22,9 +22,9 @@
 use glam::Vec3;
 use rayon::prelude::*;
 
-use super::color::{rgb_to_xyz, xyz_to_lab, xyz_to_rgb, xyz_to_ycxcz, ycxcz_to_xyz};
-use super::image::{ErrorMap, LinearImage, same_dims, same_size};
+use crate::color::{rgb_to_xyz, xyz_to_lab, xyz_to_rgb, xyz_to_ycxcz, ycxcz_to_xyz};
 use crate::error::Result;
+use crate::image::{ErrorMap, LinearImage, same_dims, same_size};
 
 /// π in `f32` (the reference's literal 3.14159265358979f rounds to the same value).
 const PI: f32 = std::f32::consts::PI;

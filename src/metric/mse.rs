@@ -10,9 +10,9 @@
 
 use rayon::prelude::*;
 
-use super::color::luminance;
-use super::image::{LinearImage, same_size};
+use crate::color::luminance;
 use crate::error::Result;
+use crate::image::{LinearImage, same_size};
 
 /// MSE-family scores of one image pair.
 #[derive(Debug, Clone, Copy, PartialEq)]

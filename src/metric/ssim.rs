@@ -18,9 +18,9 @@
 
 use rayon::prelude::*;
 
-use super::color::{linear_to_srgb_fast, luminance};
-use super::image::{LinearImage, same_size};
+use crate::color::{linear_to_srgb_fast, luminance};
 use crate::error::{Error, Result};
+use crate::image::{LinearImage, same_size};
 
 const K1: f64 = 0.01;
 const K2: f64 = 0.03;

@@ -3,7 +3,7 @@
 
 use glam::Vec3;
 
-use crate::metric::color::linear_to_srgb;
+use crate::color::linear_to_srgb;
 
 /// Triangle id of a pixel no triangle covers.
 pub const NO_TRIANGLE: u32 = u32::MAX;
@@ -110,4 +110,11 @@ pub fn contact_sheet(
         );
     }
     sheet
+}
+
+impl From<&Frame> for crate::image::LinearImage {
+    fn from(f: &Frame) -> crate::image::LinearImage {
+        crate::image::LinearImage::new(f.width() as usize, f.height() as usize, f.color().to_vec())
+            .expect("a frame has at least one pixel and one colour per pixel")
+    }
 }

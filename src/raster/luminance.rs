@@ -60,6 +60,7 @@ use glam::{Mat4, Vec2, Vec3};
 use rayon::prelude::*;
 use smallvec::SmallVec;
 
+use super::RenderScene;
 use super::clip::ClipPlanes;
 use super::crew::Crew;
 use super::edge::{self, EMPTY};
@@ -71,7 +72,7 @@ use super::{camera_setup, fixed, rect_union as union};
 use crate::error::{Error, Result};
 use crate::mesh::adjacency::Adjacency;
 use crate::prefetch::{prefetch, prefetch_at};
-use crate::scene::{Camera, Scene};
+use crate::scene::Camera;
 
 /// Tile edge of the triangle buckets, pixels.
 pub const BUCKET: u32 = 16;
@@ -582,7 +583,7 @@ impl LumaViews {
     /// targets are made: render the original and take [`LumaViews::images`].
     pub fn new(
         mesh: &Adjacency,
-        scene: &Scene,
+        scene: &RenderScene,
         cameras: &[Camera],
         width: u32,
         height: u32,
@@ -717,7 +718,7 @@ impl LumaViews {
     /// instead of every view's (a dense original's pieces take tens of MB per view).
     pub fn images_of(
         mesh: &Adjacency,
-        scene: &Scene,
+        scene: &RenderScene,
         cameras: &[Camera],
         width: u32,
         height: u32,
@@ -2029,11 +2030,11 @@ mod tests {
     }
 
     /// A level-3 icosphere's scene, `n` cameras around it and its adjacency.
-    fn icosphere_views(n: u32) -> (Scene, Vec<Camera>, Adjacency) {
+    fn icosphere_views(n: u32) -> (RenderScene, Vec<Camera>, Adjacency) {
         let mesh = Arc::new(shapes::icosphere(3));
         let cams = cameras(&mesh, n);
         let adj = Adjacency::new(&mesh);
-        (Scene::new(mesh), cams, adj)
+        (RenderScene::of(mesh), cams, adj)
     }
 
     #[test]
@@ -2098,7 +2099,7 @@ mod tests {
     fn incremental_delta_equals_full_energy_difference() {
         // Move a vertex: ΔE from the trial equals E(after) − E(before) from full renders.
         let original = Arc::new(shapes::icosphere(3));
-        let scene = Scene::new(original.clone());
+        let scene = RenderScene::of(original.clone());
         let cams = cameras(&original, 4);
         let targets = LumaViews::new(&Adjacency::new(&original), &scene, &cams, 64, 64, None)
             .unwrap()
@@ -2148,7 +2149,7 @@ mod tests {
         // final mesh, all three layers of every pixel included, and the accepted ΔE add up to its
         // energy exactly.
         let original = Arc::new(shapes::icosphere(3));
-        let scene = Scene::new(original.clone());
+        let scene = RenderScene::of(original.clone());
         let cams = cameras(&original, 5);
         let (w, h) = (48, 40);
         let targets = LumaViews::new(&Adjacency::new(&original), &scene, &cams, w, h, None)

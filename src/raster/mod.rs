@@ -31,6 +31,7 @@ mod prepare;
 mod recycle;
 mod region;
 mod resolve;
+mod scene;
 mod setup;
 mod shade;
 mod tangents;
@@ -39,11 +40,12 @@ mod texture;
 use rayon::prelude::*;
 
 use crate::error::{Error, Result};
-use crate::scene::{Camera, Projection, Scene};
+use crate::scene::{Camera, Projection};
 
 pub use frame::{Frame, NO_TRIANGLE, contact_sheet};
 pub use prepare::PreparedMesh;
 pub use region::RegionRenderer;
+pub use scene::RenderScene;
 #[cfg(feature = "gpu")]
 pub(crate) use shade::ResolvedLight;
 pub use texture::MipTexture;
@@ -207,7 +209,7 @@ impl Default for RenderSettings {
 }
 
 /// Render `scene` from `camera`.
-pub fn render(scene: &Scene, camera: &Camera, settings: &RenderSettings) -> Result<Frame> {
+pub fn render(scene: &RenderScene, camera: &Camera, settings: &RenderSettings) -> Result<Frame> {
     settings.check()?;
     let pass = resolve::Pass::new(scene, camera, settings, false);
     Ok(pass.resolve_frame(&pass.context(None)))
@@ -218,7 +220,7 @@ pub fn render(scene: &Scene, camera: &Camera, settings: &RenderSettings) -> Resu
 /// surface seen whole exactly once; with back faces culled a closed mesh covers each sample at most once.
 /// Returned row-major per pixel, `samples.count()` entries per pixel.
 pub fn coverage_counts(
-    scene: &Scene,
+    scene: &RenderScene,
     camera: &Camera,
     settings: &RenderSettings,
 ) -> Result<Vec<u16>> {

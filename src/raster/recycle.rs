@@ -161,14 +161,15 @@ mod tests {
 
     #[test]
     fn a_render_on_recycled_garbage_equals_one_on_fresh_buffers() {
+        use crate::raster::RenderScene;
         use crate::raster::{RenderSettings, Shading, render};
-        use crate::scene::{Rig, Scene};
+        use crate::scene::Rig;
         use std::sync::Arc;
         // A size no other test renders at, so no other thread takes or gives these buffers.
         let (w, h) = (263, 257);
         let n = (w * h) as usize;
-        let scene = Scene::new(Arc::new(crate::mesh::shapes::icosphere(3)));
-        let camera = crate::commands::rig_cameras(scene.mesh(), &Rig::Dodecahedron, 1.0)[4];
+        let scene = RenderScene::of(Arc::new(crate::mesh::shapes::icosphere(3)));
+        let camera = Rig::Dodecahedron.cameras(scene.mesh(), 1.0)[4];
         let mut settings = RenderSettings::DEFAULT;
         (settings.width, settings.height, settings.shading) = (w, h, Shading::Phong);
         let drain = || {

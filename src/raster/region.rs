@@ -18,13 +18,14 @@
 
 use glam::Vec3;
 
+use super::RenderScene;
 use super::edge::{self, TileSamples};
 use super::frame::Frame;
 use super::resolve::{Pass, frame_rect};
 use super::setup::{setup_one, transform_one};
 use super::{RenderSettings, Shading, rect_union, shade};
 use crate::error::{Error, Result};
-use crate::scene::{Camera, Scene};
+use crate::scene::Camera;
 
 /// A frame kept together with its set-up state for incremental updates.
 #[derive(Debug)]
@@ -37,7 +38,7 @@ pub struct RegionRenderer {
 impl RegionRenderer {
     /// Render `scene` fully and keep what an update needs.
     pub fn new(
-        scene: &Scene,
+        scene: &RenderScene,
         camera: &Camera,
         settings: &RenderSettings,
     ) -> Result<RegionRenderer> {
@@ -61,7 +62,7 @@ impl RegionRenderer {
     /// Replace the scene by `scene`, which differs from the current one only in the source
     /// triangles `changed`, and re-render what that can change. Returns the re-rendered pixel
     /// rectangle `[x0, y0, x1, y1)`, or `None` when none of the triangles is or was on screen.
-    pub fn update(&mut self, scene: &Scene, changed: &[u32]) -> Result<Option<[i32; 4]>> {
+    pub fn update(&mut self, scene: &RenderScene, changed: &[u32]) -> Result<Option<[i32; 4]>> {
         let (old, new) = (self.pass.scene.mesh(), scene.mesh());
         if old.triangle_count() != new.triangle_count() || old.vertex_count() != new.vertex_count()
         {

@@ -7,6 +7,7 @@ use std::borrow::Cow;
 use glam::{Mat4, Vec3};
 use rayon::prelude::*;
 
+use super::RenderScene;
 use super::bin::{self, Binned};
 use super::clip::ClipPlanes;
 use super::edge::{self, EMPTY, TileSamples};
@@ -15,12 +16,12 @@ use super::recycle;
 use super::setup::{self, Viewport, XfVertex};
 use super::shade::{ResolvedLight, ShadeContext};
 use super::{RenderSettings, Shading, camera_setup, vertex_lighting};
-use crate::scene::{Camera, Scene};
+use crate::scene::Camera;
 
 /// Set-up state of one frame.
 #[derive(Debug)]
 pub(crate) struct Pass {
-    pub scene: Scene,
+    pub scene: RenderScene,
     pub settings: RenderSettings,
     pub mvp: Mat4,
     pub vp: Viewport,
@@ -139,7 +140,7 @@ fn frame_tiles(frame: &mut Frame, tile: usize) -> Vec<RectMut<'_>> {
 
 impl Pass {
     pub fn new(
-        scene: &Scene,
+        scene: &RenderScene,
         camera: &Camera,
         settings: &RenderSettings,
         count_coverage: bool,

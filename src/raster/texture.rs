@@ -11,8 +11,8 @@
 
 use glam::{Vec2, Vec3};
 
+use crate::color::srgb8_to_linear_table;
 use crate::mesh::{ColorSpace, Texture};
-use crate::metric::color::srgb8_to_linear_table;
 
 /// One level of the pyramid.
 #[derive(Debug, Clone)]

@@ -15,18 +15,14 @@ use std::sync::Arc;
 
 use glam::Vec3;
 
+use crate::color::srgb_to_linear;
 use crate::mesh::Mesh;
-use crate::metric::color::srgb_to_linear;
-use crate::raster::PreparedMesh;
 
-/// A mesh ready to render, with its lights and background.
-///
-/// Building a scene does the per-mesh work once (mip pyramids, tangents); every view of it
-/// reuses that work.
+/// What is seen: a mesh, its lights and the background. Renderers keep their own prepared form
+/// beside it (`raster::RenderScene`, the GPU mirror's `GpuScene`).
 #[derive(Debug, Clone)]
 pub struct Scene {
     mesh: Arc<Mesh>,
-    prepared: Arc<PreparedMesh>,
     /// Lights. Default value: one [`Light::HEADLIGHT`].
     pub lights: Vec<Light>,
     /// Linear RGB background. Default value: mid-grey, sRGB 0.5 (≈ 0.214 linear).
@@ -41,10 +37,8 @@ impl Scene {
 
     /// A scene with DESIGN.md's defaults: one headlight, mid-grey background.
     pub fn new(mesh: Arc<Mesh>) -> Scene {
-        let prepared = Arc::new(PreparedMesh::new(&mesh));
         Scene {
             mesh,
-            prepared,
             lights: vec![Light::HEADLIGHT],
             background: Vec3::splat(srgb_to_linear(0.5)),
             ambient: Self::DEFAULT_AMBIENT,
@@ -54,8 +48,8 @@ impl Scene {
     pub fn mesh(&self) -> &Mesh {
         &self.mesh
     }
-    /// Per-mesh render data.
-    pub fn prepared(&self) -> &PreparedMesh {
-        &self.prepared
+    /// The mesh, shared.
+    pub fn mesh_arc(&self) -> &Arc<Mesh> {
+        &self.mesh
     }
 }

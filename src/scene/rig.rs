@@ -11,6 +11,9 @@
 
 use glam::Vec3;
 
+use super::Camera;
+use crate::mesh::Mesh;
+
 const PHI: f32 = 1.618_034;
 
 /// A set of view directions.
@@ -29,6 +32,23 @@ pub enum Rig {
 }
 
 impl Rig {
+    /// Cameras for every view, in view-number order, each framing `mesh`'s bounding sphere at the
+    /// default field of view and margin, for images of width/height `aspect`.
+    pub fn cameras(&self, mesh: &Mesh, aspect: f32) -> Vec<Camera> {
+        self.directions()
+            .into_iter()
+            .map(|d| {
+                Camera::frame_sphere(
+                    mesh.bounding_sphere(),
+                    d,
+                    Camera::DEFAULT_FOV_Y_DEG,
+                    aspect,
+                    Camera::DEFAULT_MARGIN,
+                )
+            })
+            .collect()
+    }
+
     /// Unit directions from the model's centre towards each camera, in view-number order.
     pub fn directions(&self) -> Vec<Vec3> {
         let s = [1.0f32, -1.0];

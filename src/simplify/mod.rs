@@ -231,7 +231,7 @@ fn chain_of(mesh: &Mesh, method: Method, goals: &[Goal]) -> Result<Vec<Lod>> {
         }
         Method::Williams => {
             let w = williams::Williams::build(mesh)?;
-            let cameras = crate::commands::rig_cameras(mesh, &crate::scene::Rig::Dodecahedron, 1.0);
+            let cameras = crate::scene::Rig::Dodecahedron.cameras(mesh, 1.0);
             let opts = williams::Options::default();
             goals
                 .iter()

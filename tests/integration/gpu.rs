@@ -7,13 +7,14 @@
 
 use std::sync::Arc;
 
-use lodeval::commands::rig_cameras;
 use lodeval::gpu::{Gpu, GpuScene};
 use lodeval::mesh::{self, LoadOptions, Mesh};
 use lodeval::metric::LinearImage;
 use lodeval::metric::flip::Flip;
-use lodeval::raster::{self, Frame, NO_TRIANGLE, RenderSettings, SamplePattern, Shading};
-use lodeval::scene::{Rig, Scene};
+use lodeval::raster::{
+    self, Frame, NO_TRIANGLE, RenderScene, RenderSettings, SamplePattern, Shading,
+};
+use lodeval::scene::Rig;
 
 use crate::common::model;
 
@@ -124,9 +125,9 @@ fn gpu_frames_match_the_cpu_reference_for_every_shading_model() {
         "bunny/stanford-bunny.obj",
         "bob/bob_tri.obj",
     ] {
-        let scene = Scene::new(load(rel));
+        let scene = RenderScene::of(load(rel));
         let on_gpu = GpuScene::new(gpu.clone(), &scene).unwrap();
-        let cameras = rig_cameras(scene.mesh(), &Rig::Dodecahedron, 1.0);
+        let cameras = Rig::Dodecahedron.cameras(scene.mesh(), 1.0);
         for shading in Shading::ALL {
             for samples in [SamplePattern::Rotated(2), SamplePattern::Ordered(1)] {
                 let s = settings(192, 160, shading, samples);
@@ -145,9 +146,9 @@ fn gpu_frames_match_the_cpu_reference_for_every_shading_model() {
 #[test]
 fn gpu_mirrors_sample_patterns_culling_and_is_repeatable() {
     let Some(gpu) = gpu() else { return };
-    let scene = Scene::new(load("spot/spot_mtl.obj"));
+    let scene = RenderScene::of(load("spot/spot_mtl.obj"));
     let on_gpu = GpuScene::new(gpu, &scene).unwrap();
-    let c = rig_cameras(scene.mesh(), &Rig::Icosahedron, 1.0)[3];
+    let c = Rig::Icosahedron.cameras(scene.mesh(), 1.0)[3];
     for samples in [
         SamplePattern::Ordered(2),
         SamplePattern::Ordered(3),

@@ -2,10 +2,11 @@
 
 use std::sync::Arc;
 
-use lodeval::commands::rig_cameras;
 use lodeval::mesh::{self, LoadOptions, Mesh, shapes};
-use lodeval::raster::{self, Frame, RenderSettings, SamplePattern, Shading, with_threads};
-use lodeval::scene::{Camera, Rig, Scene};
+use lodeval::raster::{
+    self, Frame, RenderScene, RenderSettings, SamplePattern, Shading, with_threads,
+};
+use lodeval::scene::{Camera, Rig};
 
 use crate::common::{lodeval, model, root};
 
@@ -38,8 +39,8 @@ fn bits(f: &Frame) -> Vec<u32> {
 fn frames_are_byte_identical_for_1_2_and_8_threads_with_every_shading_model() {
     // Spot (textured OBJ) and the barrel (glTF with a normal map), non-square to catch x/y mix-ups.
     for rel in ["spot/spot_mtl.obj", "barrel/barrel.glb"] {
-        let scene = Scene::new(load(rel));
-        let camera = rig_cameras(scene.mesh(), &Rig::Dodecahedron, 1.5)[5];
+        let scene = RenderScene::of(load(rel));
+        let camera = Rig::Dodecahedron.cameras(scene.mesh(), 1.5)[5];
         for shading in Shading::ALL {
             let mut s = settings(96, shading);
             s.width = 144;
@@ -60,11 +61,12 @@ fn frames_are_byte_identical_for_1_2_and_8_threads_with_every_shading_model() {
 
 /// Coverage counts of a closed mesh from every view of a rig.
 fn counts(mesh: Arc<Mesh>, cull: bool, pattern: SamplePattern) -> Vec<Vec<u16>> {
-    let scene = Scene::new(mesh);
+    let scene = RenderScene::of(mesh);
     let mut s = settings(160, Shading::Unlit);
     s.cull_backfaces = cull;
     s.samples = pattern;
-    rig_cameras(scene.mesh(), &Rig::Icosahedron, 1.0)
+    Rig::Icosahedron
+        .cameras(scene.mesh(), 1.0)
         .iter()
         .map(|c| raster::coverage_counts(&scene, c, &s).unwrap())
         .collect()
@@ -119,7 +121,7 @@ fn top_left_rule_splits_shared_edges_through_sample_centres() {
     // the square is covered exactly once; those on the square's top and left edges count, those
     // on its bottom and right edges do not.
     let mesh = Arc::new(quad_mesh());
-    let scene = Scene::new(mesh);
+    let scene = RenderScene::of(mesh);
     let mut s = settings(8, Shading::Unlit);
     s.samples = SamplePattern::Ordered(1);
     let camera = Camera {
@@ -206,10 +208,10 @@ fn assert_golden(name: &str, frame: &Frame) {
 
 #[test]
 fn golden_images() {
-    let spot = Scene::new(load("spot/spot_mtl.obj"));
-    let barrel = Scene::new(load("barrel/barrel.glb"));
-    let sphere = Scene::new(Arc::new(shapes::icosphere(2)));
-    let cases: [(&str, &Scene, Shading, usize); 5] = [
+    let spot = RenderScene::of(load("spot/spot_mtl.obj"));
+    let barrel = RenderScene::of(load("barrel/barrel.glb"));
+    let sphere = RenderScene::of(Arc::new(shapes::icosphere(2)));
+    let cases: [(&str, &RenderScene, Shading, usize); 5] = [
         ("spot-gouraud-v3", &spot, Shading::Gouraud, 3),
         ("spot-unlit-v0", &spot, Shading::Unlit, 0),
         ("barrel-normal-mapped-v1", &barrel, Shading::NormalMapped, 1),
@@ -217,7 +219,7 @@ fn golden_images() {
         ("sphere-depth-v0", &sphere, Shading::Depth, 0),
     ];
     for (name, scene, shading, view) in cases {
-        let camera = rig_cameras(scene.mesh(), &Rig::Dodecahedron, 1.0)[view];
+        let camera = Rig::Dodecahedron.cameras(scene.mesh(), 1.0)[view];
         assert_golden(
             name,
             &raster::render(scene, &camera, &settings(64, shading)).unwrap(),
@@ -286,7 +288,7 @@ fn render_cli_writes_pngs_and_rejects_bad_requests() {
 /// Ray-cast the camera's pixel centres with an independent BVH (obvhs, Möller–Trumbore) and
 /// return (compared surface pixels, mismatching ones, surface pixels within a pixel of an edge,
 /// mismatching ones among those).
-fn raycast_agreement(scene: &Scene, camera: &Camera, size: u32) -> [usize; 4] {
+fn raycast_agreement(scene: &RenderScene, camera: &Camera, size: u32) -> [usize; 4] {
     use obvhs::{
         BvhBuildParams,
         cwbvh::builder::build_cwbvh_from_tris,
@@ -370,12 +372,9 @@ fn triangle_ids_match_an_independent_ray_caster_away_from_edges() {
         ("bunny/bunny_odedstein_3k.obj", 768),
         ("bunny/stanford-bunny.obj", 1024),
     ] {
-        let scene = Scene::new(load(rel));
+        let scene = RenderScene::of(load(rel));
         let mut t = [0; 4];
-        for camera in rig_cameras(scene.mesh(), &Rig::Icosahedron, 1.0)
-            .iter()
-            .take(6)
-        {
+        for camera in Rig::Icosahedron.cameras(scene.mesh(), 1.0).iter().take(6) {
             let r = raycast_agreement(&scene, camera, size);
             (0..4).for_each(|k| t[k] += r[k]);
         }
@@ -445,8 +444,8 @@ fn region_update_gives_exactly_the_full_render() {
         ("spot/spot_mtl.obj", Shading::Unlit),
     ] {
         let mut mesh = Arc::new(mesh::load(&model(rel), &LoadOptions::DEFAULT).unwrap());
-        let scene = Scene::new(mesh.clone());
-        let camera = rig_cameras(&mesh, &Rig::Dodecahedron, 1.0)[2];
+        let scene = RenderScene::of(mesh.clone());
+        let camera = Rig::Dodecahedron.cameras(&mesh, 1.0)[2];
         let s = settings(160, shading);
         let mut region = raster::RegionRenderer::new(&scene, &camera, &s).unwrap();
         let mut largest = 0;
@@ -454,7 +453,7 @@ fn region_update_gives_exactly_the_full_render() {
             // One position per edit (with its seam copies): a local move, as the optimizer makes.
             let (edited, changed) = nudge(&mesh, step, 1, 0.02);
             mesh = Arc::new(edited);
-            let scene = Scene::new(mesh.clone());
+            let scene = RenderScene::of(mesh.clone());
             if let Some(r) = region.update(&scene, &changed).unwrap() {
                 largest = largest.max((r[2] - r[0]) * (r[3] - r[1]));
             }
@@ -499,7 +498,7 @@ fn region_update_gives_exactly_the_full_render() {
             changed.extend([0, t1 as u32]);
             changed.sort();
             changed.dedup();
-            let scene = Scene::new(swapped);
+            let scene = RenderScene::of(swapped);
             region.update(&scene, &changed).unwrap();
             let full = raster::render(&scene, &camera, &s).unwrap();
             assert!(

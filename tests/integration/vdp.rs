@@ -7,7 +7,6 @@
 use std::sync::Arc;
 
 use glam::Vec3;
-use lodeval::commands::rig_cameras;
 use lodeval::eval::config::{DistanceConfig, ViewingConfig};
 use lodeval::eval::distance::{DistanceJob, search};
 use lodeval::mesh::shapes;
@@ -15,8 +14,8 @@ use lodeval::metric::LinearImage;
 use lodeval::metric::csf::daly_rushmeier;
 use lodeval::metric::vdp::modelfest::{Condition, ModelFest, calibrate};
 use lodeval::metric::vdp::{Display, Vdp, VdpParams};
-use lodeval::raster::{self, RenderSettings, with_threads};
-use lodeval::scene::{Rig, Scene, Viewing};
+use lodeval::raster::{self, RenderScene, RenderSettings, with_threads};
+use lodeval::scene::{Rig, Viewing};
 use lodeval::simplify::{Goal, Method, chain};
 
 use crate::common::{lodeval, model, root};
@@ -147,8 +146,8 @@ fn coarser_lods_score_higher_and_identical_scores_zero() {
     // Along an LOD chain of a torus (12×6 → 24×12 → 48×24 quads against 192×96), each coarser
     // LOD must be predicted more visible than the next finer one.
     let render = |rings: u32, sides: u32| {
-        let scene = Scene::new(Arc::new(shapes::torus(rings, sides, 0.35)));
-        let camera = rig_cameras(scene.mesh(), &Rig::Dodecahedron, 1.0)[3];
+        let scene = RenderScene::of(Arc::new(shapes::torus(rings, sides, 0.35)));
+        let camera = Rig::Dodecahedron.cameras(scene.mesh(), 1.0)[3];
         let mut s = RenderSettings::DEFAULT;
         (s.width, s.height) = (128, 128);
         LinearImage::from(&raster::render(&scene, &camera, &s).unwrap())
@@ -391,10 +390,10 @@ fn calibrate_prints_json_and_writes_the_table_and_plot() {
 fn bunny_frame() -> LinearImage {
     let mesh =
         lodeval::mesh::load(&model("bunny/stanford-bunny.obj"), &Default::default()).unwrap();
-    let camera = rig_cameras(&mesh, &Rig::Dodecahedron, 1.0)[3];
+    let camera = Rig::Dodecahedron.cameras(&mesh, 1.0)[3];
     LinearImage::from(
         &raster::render(
-            &Scene::new(Arc::new(mesh)),
+            &RenderScene::of(Arc::new(mesh)),
             &camera,
             &RenderSettings::DEFAULT,
         )
@@ -451,7 +450,10 @@ fn half_the_triangles_of_a_dense_scan_is_invisible_at_a_hundred_and_fifty_pixels
         .remove(0)
         .mesh;
     let directions: Vec<Vec3> = Rig::Dodecahedron.directions().into_iter().take(3).collect();
-    let (original, lod) = (Scene::new(Arc::new(mesh)), Scene::new(Arc::new(lod)));
+    let (original, lod) = (
+        RenderScene::of(Arc::new(mesh)),
+        RenderScene::of(Arc::new(lod)),
+    );
     let job = DistanceJob {
         original: &original,
         lod: &lod,

@@ -59,9 +59,9 @@ use self::adaptation::BandAdaptation;
 use self::bands::Plane;
 use self::filter::CsfFilter;
 use super::csf::DalyCsf;
-use super::image::{ErrorMap, LinearImage, same_dims, same_size};
+use crate::color::luminance;
 use crate::error::{Error, Result};
-use crate::metric::color::luminance;
+use crate::image::{ErrorMap, LinearImage, same_dims, same_size};
 use crate::scene::Viewing;
 
 /// The model's free parameters (the fitted ones by default; others for fitting and experiments).

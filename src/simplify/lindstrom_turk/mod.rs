@@ -39,8 +39,9 @@ use stats::{Move, Stats};
 use crate::error::{Error, Result};
 use crate::mesh::Mesh;
 use crate::mesh::adjacency::Adjacency;
+use crate::raster::RenderScene;
 use crate::raster::luminance::LumaViews;
-use crate::scene::{Camera, Rig, Scene};
+use crate::scene::{Camera, Rig};
 
 /// Edges per iteration of the outer loop.
 pub const BATCH: usize = 64;
@@ -151,12 +152,12 @@ pub fn held_out_rig(n: u32) -> Rig {
 
 /// Cameras framing `original` from every direction of `rig` (square images).
 pub fn cameras(original: &Mesh, rig: &Rig) -> Vec<Camera> {
-    crate::commands::rig_cameras(original, rig, 1.0)
+    rig.cameras(original, 1.0)
 }
 
 /// The luminance images of `original` from `cameras` (the optimizer's targets ŷ).
 pub fn target_images(original: &Arc<Mesh>, cameras: &[Camera], size: u32) -> Result<Vec<Vec<u16>>> {
-    let scene = Scene::new(original.clone());
+    let scene = RenderScene::of(original.clone());
     let adj = Adjacency::new(original);
     LumaViews::images_of(&adj, &scene, cameras, size, size)
 }
@@ -168,7 +169,7 @@ pub fn d_ms(
     size: u32,
     targets: Vec<Vec<u16>>,
 ) -> Result<f64> {
-    let scene = Scene::new(mesh.clone());
+    let scene = RenderScene::of(mesh.clone());
     let adj = Adjacency::new(mesh);
     let views = LumaViews::new(&adj, &scene, cameras, size, size, Some(targets))?;
     Ok(views.d_ms(views.energy()))
@@ -211,7 +212,7 @@ impl Targets {
 #[derive(Debug)]
 pub(crate) struct Setup {
     targets: Targets,
-    scene: Scene,
+    scene: RenderScene,
 }
 
 /// Vertices with at least one live triangle.
@@ -228,7 +229,7 @@ impl Optimizer {
         simplified: &Arc<Mesh>,
         opts: &Options,
     ) -> Result<(Optimizer, Setup)> {
-        let scene = Scene::new(simplified.clone());
+        let scene = RenderScene::of(simplified.clone());
         let adj = edit::prepare(Adjacency::new(simplified), opts.normals);
         let views = LumaViews::new(
             &adj,

@@ -26,11 +26,11 @@ use super::{Criterion, Cut, Options, Williams};
 use crate::error::{Error, Result};
 use crate::eval::config::MetricFamily;
 use crate::eval::score::{Reference, Scorer};
+use crate::image::LinearImage;
 use crate::io::plot::{Series, line_plot};
 use crate::mesh::{self, LoadOptions, Mesh};
-use crate::metric::LinearImage;
-use crate::raster::{self, Frame, RenderSettings, SamplePattern, Shading};
-use crate::scene::{Camera, Rig, Scene, Viewing};
+use crate::raster::{self, Frame, RenderScene, RenderSettings, SamplePattern, Shading};
+use crate::scene::{Camera, Rig, Viewing};
 
 /// Largest image side in the contact sheets, pixels.
 pub const SHEET_SIZE: u32 = 512;
@@ -216,7 +216,7 @@ fn score(
     camera: &Camera,
     settings: &RenderSettings,
 ) -> Result<(f64, f64, f64, Frame)> {
-    let frame = raster::render(&Scene::new(Arc::new(mesh)), camera, settings)?;
+    let frame = raster::render(&RenderScene::of(Arc::new(mesh)), camera, settings)?;
     let s = scorer.score(reference, &linear(&frame)?)?;
     let get = |m: &str| s.get(m).unwrap_or(f64::NAN);
     Ok((get("flip"), get("vdp"), get("vdp_jnd"), frame))
@@ -249,9 +249,9 @@ pub fn run(config: &Path, log: &mut dyn FnMut(&str)) -> Result<Vec<SummaryRow>> 
             mt_triangles: w.hierarchy.tris.len(),
             seconds: start.elapsed().as_secs_f64(),
         });
-        let cameras = crate::commands::rig_cameras(&original, &rig, 1.0);
+        let cameras = rig.cameras(&original, 1.0);
         let original = Arc::new(original);
-        let scene = Scene::new(original.clone());
+        let scene = RenderScene::of(original.clone());
         let single = settings(exp.single_size, exp.samples, shading);
         let mean = settings(exp.mean_size, exp.samples, shading);
         let single_ref = scorer.prepare(linear(&raster::render(&scene, &cameras[0], &single)?)?);

@@ -510,7 +510,7 @@ mod tests {
     fn budgets_hold_along_a_camera_path_with_temporal_coherence_and_determinism() {
         let mesh = bunny_3k();
         let w = Williams::build(&mesh).unwrap();
-        let cams = crate::commands::rig_cameras(&mesh, &crate::scene::Rig::Fibonacci(24), 1.0);
+        let cams = crate::scene::Rig::Fibonacci(24).cameras(&mesh, 1.0);
         let opts = Options::default();
         let run = || {
             let mut cut = Cut::coarsest(&w.hierarchy);

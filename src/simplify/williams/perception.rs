@@ -143,7 +143,7 @@ impl ViewModel {
                 ViewLight {
                     l: dir,
                     h: (dir + to_eye).normalize_or_zero(),
-                    y: crate::metric::color::luminance(color),
+                    y: crate::color::luminance(color),
                 }
             })
             .collect();

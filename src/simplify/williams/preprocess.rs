@@ -25,8 +25,8 @@ use glam::{Vec2, Vec3};
 use super::bounds::{Ball, Cone, Range};
 use super::hierarchy::Hierarchy;
 use super::texels::{LuminancePyramid, normal_map_tilt};
+use crate::color::luminance;
 use crate::mesh::surface_distance::point_triangle_distance2;
-use crate::metric::color::luminance;
 
 /// What the run-time evaluation needs of one node.
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -15,8 +15,8 @@
 use glam::{Vec2, Vec3};
 
 use super::bounds::Range;
+use crate::color::{luminance, srgb_to_linear};
 use crate::mesh::{ColorSpace, Texture};
-use crate::metric::color::{luminance, srgb_to_linear};
 
 /// Largest box side, in texels, read at the chosen level.
 pub const MAX_SPAN: i64 = 4;

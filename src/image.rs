@@ -3,8 +3,8 @@
 
 use glam::Vec3;
 
+use crate::color::srgb8_to_linear_table;
 use crate::error::{Error, Result};
-use crate::metric::color::srgb8_to_linear_table;
 
 /// A linear-light RGB image.
 ///
@@ -74,16 +74,6 @@ impl LinearImage {
     /// Linear RGB pixels.
     pub fn pixels(&self) -> &[Vec3] {
         &self.pixels
-    }
-}
-
-impl From<&crate::raster::Frame> for LinearImage {
-    fn from(f: &crate::raster::Frame) -> LinearImage {
-        LinearImage {
-            width: f.width() as usize,
-            height: f.height() as usize,
-            pixels: f.color().to_vec(),
-        }
     }
 }
 
