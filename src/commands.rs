@@ -1010,30 +1010,9 @@ pub fn optimize(job: &OptimizeJob) -> Result<crate::simplify::lindstrom_turk::Ou
     bar.finish_and_clear();
     crate::mesh::write_obj::write(&outcome.mesh, &job.out)?;
     if let Some(path) = &job.energy_csv {
-        write_energy_csv(path, &outcome.log)?;
+        crate::io::csv::write_rows(path, None, &outcome.log)?;
     }
     Ok(outcome)
-}
-
-/// Write an energy log as CSV (evals, seconds, d_ms, relative), atomically.
-pub fn write_energy_csv(
-    path: &Path,
-    log: &[crate::simplify::lindstrom_turk::EnergyRow],
-) -> Result<()> {
-    write_rows_csv(path, log)
-}
-
-/// Write serializable rows as CSV (header from the field names), atomically.
-pub fn write_rows_csv<T: serde::Serialize>(path: &Path, rows: &[T]) -> Result<()> {
-    let mut w = csv::Writer::from_writer(Vec::new());
-    for row in rows {
-        w.serialize(row)
-            .map_err(|e| Error::Internal(format!("{}: {e}", path.display())))?;
-    }
-    let bytes = w
-        .into_inner()
-        .map_err(|e| Error::Internal(format!("{}: {e}", path.display())))?;
-    crate::io::write_atomic(path, &bytes)
 }
 
 /// A `lodeval calibrate modelfest` request.
@@ -1061,7 +1040,7 @@ pub fn calibrate(job: &CalibrateJob) -> Result<crate::metric::vdp::modelfest::Ca
                 "give a writable --out folder",
             )
         })?;
-        write_rows_csv(&dir.join("modelfest.csv"), &result.stimuli)?;
+        crate::io::csv::write_rows(&dir.join("modelfest.csv"), None, &result.stimuli)?;
         let points: Vec<crate::io::plot::LabelledPoint> = result
             .stimuli
             .iter()

@@ -2,6 +2,7 @@
 //! so a crash or a bad input never leaves a half-written output (DESIGN.md, "Errors"). The 8-bit
 //! image writers here are the only place where linear colour becomes sRGB bytes on disk.
 
+pub mod csv;
 pub mod plot;
 
 use std::io::Write;

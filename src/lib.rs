@@ -28,6 +28,7 @@ pub mod commands;
 pub mod cpu;
 pub mod error;
 pub mod eval;
+pub mod experiments;
 #[cfg(feature = "gpu")]
 pub mod gpu;
 pub mod image;

@@ -853,12 +853,11 @@ fn run(cli: Cli) -> Result<(), Error> {
             use lodeval::simplify::lindstrom_turk::{Normals, Options};
             if let Some(config) = &a.experiment {
                 let quiet = cli.quiet;
-                let rows =
-                    lodeval::simplify::lindstrom_turk::experiment::run(config, &mut |line| {
-                        if !quiet {
-                            eprintln!("{line}");
-                        }
-                    })?;
+                let rows = lodeval::experiments::lindstrom_turk::run(config, &mut |line| {
+                    if !quiet {
+                        eprintln!("{line}");
+                    }
+                })?;
                 println!("{} runs; results.csv and plots written", rows.len());
                 return Ok(());
             }
@@ -917,9 +916,8 @@ fn run(cli: Cli) -> Result<(), Error> {
             experiment: Some(config),
             ..
         }) => {
-            let rows = lodeval::simplify::williams::experiment::run(&config, &mut |line| {
-                eprintln!("{line}")
-            })?;
+            let rows =
+                lodeval::experiments::williams2003::run(&config, &mut |line| eprintln!("{line}"))?;
             eprintln!("{} curve points written", rows.len());
             Ok(())
         }

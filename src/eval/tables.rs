@@ -16,7 +16,7 @@ use std::path::Path;
 
 use serde::{Deserialize, Serialize};
 
-use crate::error::{Error, Result};
+use crate::error::Result;
 
 /// One image pair and metric.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -422,43 +422,14 @@ impl Columns for LodInfo {
     ];
 }
 
-/// Write rows as CSV with a header (also for an empty table), atomically.
+/// Write rows as CSV with their schema's header (also for an empty table), atomically.
 pub fn write_csv<T: Serialize + Columns>(path: &Path, rows: &[T]) -> Result<()> {
-    let mut w = ::csv::WriterBuilder::new()
-        .has_headers(false)
-        .from_writer(Vec::new());
-    let fail =
-        |e: &dyn std::fmt::Display| Error::Internal(format!("writing {}: {e}", path.display()));
-    w.write_record(T::COLUMNS).map_err(|e| fail(&e))?;
-    for r in rows {
-        w.serialize(r).map_err(|e| fail(&e))?;
-    }
-    let bytes = w.into_inner().map_err(|e| fail(&e))?;
-    crate::io::write_atomic(path, &bytes)
+    crate::io::csv::write_rows(path, Some(T::COLUMNS), rows)
 }
 
 /// Read a CSV written by [`write_csv`].
 pub fn read_csv<T: for<'de> Deserialize<'de>>(path: &Path) -> Result<Vec<T>> {
-    let mut r = ::csv::Reader::from_path(path).map_err(|e| {
-        Error::input(
-            path,
-            format!("cannot read: {e}"),
-            "give the output folder of an `lodeval eval` run",
-        )
-    })?;
-    r.deserialize()
-        .enumerate()
-        .map(|(i, row)| {
-            row.map_err(|e| {
-                Error::input_at(
-                    path,
-                    crate::error::Location::Line(i + 2),
-                    format!("is not an lodeval table: {e}"),
-                    "give the output folder of an `lodeval eval` run",
-                )
-            })
-        })
-        .collect()
+    crate::io::csv::read_rows(path, "give the output folder of an `lodeval eval` run")
 }
 
 #[cfg(test)]

@@ -19,7 +19,6 @@
 //! and every random choice comes from a seeded PCG, so a run is reproducible for any thread count.
 
 mod edit;
-pub mod experiment;
 mod moves;
 pub mod oracle;
 pub mod simplex;

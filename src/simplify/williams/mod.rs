@@ -9,14 +9,13 @@
 //! - `perception.rs` — per-view contrast, frequency and imperceptibility distance (§3, §5.2–5.4),
 //!   and the comparison criteria of §6;
 //! - `cut.rs` — best-effort dual-queue refinement to a budget with temporal coherence (§5.1);
-//! - `experiment.rs` — the paper's evaluation (§6, Figure 4).
+//! The paper's evaluation (§6, Figure 4) is `crate::experiments::williams2003`.
 //!
 //! This file ties them together: build once ([`Williams::build`]), then adapt a cut per camera
 //! ([`Williams::adapt`]), or make a static LOD for a set of views ([`Williams::static_lod`]).
 
 pub mod bounds;
 pub mod cut;
-pub mod experiment;
 pub mod hierarchy;
 pub mod perception;
 pub mod preprocess;

@@ -11,10 +11,12 @@ use std::sync::Arc;
 
 use serde::{Deserialize, Serialize};
 
-use super::{Options, Targets, cameras, d_ms, held_out_rig, optimize_towards, target_images};
 use crate::error::{Error, Result};
 use crate::io::plot::{Series, line_plot as plot};
 use crate::mesh::{self, LoadOptions, Mesh};
+use crate::simplify::lindstrom_turk::{
+    Options, Targets, cameras, d_ms, held_out_rig, optimize_towards, target_images,
+};
 use crate::simplify::{Goal, Method, chain};
 
 /// One model of the experiment.
@@ -152,8 +154,9 @@ pub fn run(config: &Path, log: &mut dyn FnMut(&str)) -> Result<Vec<ResultRow>> {
                     &result,
                     &out.join("meshes").join(format!("{stem}-optimized.obj")),
                 )?;
-                crate::commands::write_energy_csv(
+                crate::io::csv::write_rows(
                     &out.join("energy").join(format!("{stem}.csv")),
+                    None,
                     &o.log,
                 )?;
                 curves.push((
@@ -190,7 +193,7 @@ pub fn run(config: &Path, log: &mut dyn FnMut(&str)) -> Result<Vec<ResultRow>> {
             }
         }
     }
-    crate::commands::write_rows_csv(&out.join("results.csv"), &rows)?;
+    crate::io::csv::write_rows(&out.join("results.csv"), None, &rows)?;
     for spec in &exp.model {
         let mut series = Vec::new();
         for m in &exp.methods {
@@ -239,7 +242,7 @@ pub fn run(config: &Path, log: &mut dyn FnMut(&str)) -> Result<Vec<ResultRow>> {
 mod tests {
     use crate::scene::Rig;
 
-    use super::super::held_out_rig;
+    use crate::simplify::lindstrom_turk::held_out_rig;
 
     #[test]
     fn held_out_views_differ_from_the_optimization_views() {

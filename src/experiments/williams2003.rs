@@ -22,7 +22,6 @@ use std::time::Instant;
 
 use serde::{Deserialize, Serialize};
 
-use super::{Criterion, Cut, Options, Williams};
 use crate::error::{Error, Result};
 use crate::eval::config::MetricFamily;
 use crate::eval::score::{Reference, Scorer};
@@ -31,6 +30,7 @@ use crate::io::plot::{Series, line_plot};
 use crate::mesh::{self, LoadOptions, Mesh};
 use crate::raster::{self, Frame, RenderScene, RenderSettings, SamplePattern, Shading};
 use crate::scene::{Camera, Rig, Viewing};
+use crate::simplify::williams::{Criterion, Cut, Options, Williams};
 
 /// Largest image side in the contact sheets, pixels.
 pub const SHEET_SIZE: u32 = 512;
@@ -375,9 +375,9 @@ pub fn run(config: &Path, log: &mut dyn FnMut(&str)) -> Result<Vec<SummaryRow>> 
             &image::DynamicImage::ImageRgb8(sheet),
         )?;
     }
-    crate::commands::write_rows_csv(&out.join("results.csv"), &rows)?;
-    crate::commands::write_rows_csv(&out.join("summary.csv"), &summary)?;
-    crate::commands::write_rows_csv(&out.join("preprocess.csv"), &pre_rows)?;
+    crate::io::csv::write_rows(&out.join("results.csv"), None, &rows)?;
+    crate::io::csv::write_rows(&out.join("summary.csv"), None, &summary)?;
+    crate::io::csv::write_rows(&out.join("preprocess.csv"), None, &pre_rows)?;
     Ok(summary)
 }
 
