@@ -3,7 +3,7 @@
 //! Figures go to results/BENCHMARKS.md; the side-by-side run with llvmpipe is
 //! benches/raster_vs_llvmpipe.sh.
 
-use lodeval::commands::{RasterBench, bench_raster};
+use lodeval::app::bench::{RasterBench, bench_raster};
 use lodeval::raster::Shading;
 
 fn main() {
@@ -18,5 +18,5 @@ fn main() {
         backend: lodeval::backend::Backend::Cpu,
     };
     let rows = bench_raster(&job).expect("benchmark runs");
-    print!("{}", lodeval::commands::raster_bench_table(&rows));
+    print!("{}", lodeval::app::bench::raster_bench_table(&rows));
 }

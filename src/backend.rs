@@ -26,21 +26,11 @@ pub enum Backend {
     Auto,
 }
 
-impl Backend {
-    /// Parse `cpu`, `gpu` or `auto`.
-    pub fn parse(s: &str) -> Option<Backend> {
-        match s {
-            "cpu" => Some(Backend::Cpu),
-            "gpu" => Some(Backend::Gpu),
-            "auto" => Some(Backend::Auto),
-            _ => None,
-        }
-    }
-}
-
 /// The chosen backend, opened.
 #[derive(Debug, Clone)]
 pub struct Engine {
+    /// Why `auto` fell back to the CPU, for the caller to tell the user.
+    fallback: Option<String>,
     #[cfg(feature = "gpu")]
     gpu: Option<(
         std::sync::Arc<crate::gpu::Gpu>,
@@ -55,6 +45,7 @@ impl Engine {
     /// The CPU reference.
     pub fn cpu() -> Engine {
         Engine {
+            fallback: None,
             #[cfg(feature = "gpu")]
             gpu: None,
         }
@@ -71,21 +62,22 @@ impl Engine {
                     .into(),
             )),
             #[cfg(not(feature = "gpu"))]
-            Backend::Auto => {
-                eprintln!(
+            Backend::Auto => Ok(Engine {
+                fallback: Some(
                     "GPU path skipped: built without the `gpu` feature; rendering on the CPU"
-                );
-                Ok(Engine::cpu())
-            }
+                        .into(),
+                ),
+                ..Engine::cpu()
+            }),
             #[cfg(feature = "gpu")]
             Backend::Gpu => Self::open_gpu(),
             #[cfg(feature = "gpu")]
             Backend::Auto => match Self::open_gpu() {
                 Ok(e) => Ok(e),
-                Err(e) => {
-                    eprintln!("{e}; rendering on the CPU");
-                    Ok(Engine::cpu())
-                }
+                Err(e) => Ok(Engine {
+                    fallback: Some(format!("{e}; rendering on the CPU")),
+                    ..Engine::cpu()
+                }),
             },
         }
     }
@@ -95,8 +87,14 @@ impl Engine {
         let gpu = crate::gpu::Gpu::new()?;
         let metrics = crate::gpu::GpuMetrics::new(gpu.clone())?;
         Ok(Engine {
+            fallback: None,
             gpu: Some((gpu, std::sync::Arc::new(metrics))),
         })
+    }
+
+    /// Why `auto` rendered on the CPU (no adapter, or a build without the GPU path), if it did.
+    pub fn fallback(&self) -> Option<&str> {
+        self.fallback.as_deref()
     }
 
     /// `cpu`, or `gpu: ADAPTER (DRIVER, API, TYPE)`.

@@ -22,9 +22,9 @@
 
 #![warn(missing_docs, missing_debug_implementations)]
 
+pub mod app;
 pub mod backend;
 pub mod color;
-pub mod commands;
 pub mod cpu;
 pub mod error;
 pub mod eval;
@@ -36,6 +36,7 @@ pub mod io;
 pub mod mesh;
 pub mod metric;
 pub(crate) mod prefetch;
+pub mod progress;
 pub mod raster;
 pub mod scene;
 pub mod simplify;

@@ -125,7 +125,7 @@ impl RenderConfig {
         let mut s = RenderSettings::DEFAULT;
         s.width = self.size.0;
         s.height = self.size.0;
-        let n = (self.samples.0 as f64).sqrt().round() as u32;
+        let n = self.samples.side();
         s.samples = match self.pattern {
             PatternName::Rotated => SamplePattern::Rotated(n),
             PatternName::Ordered => SamplePattern::Ordered(n),
@@ -495,9 +495,16 @@ checked_newtype!(
 );
 checked_newtype!(
     /// Samples per pixel, a square n² with 1 ≤ n ≤ 8.
-    SampleCount(u32), "u32", |v| (1..=8u32).any(|n| n * n == v),
+    SampleCount(u32), "u32", |v| SamplePattern::side_for(v).is_some(),
     "use 1, 4, 9, 16, 25, 36, 49 or 64 samples per pixel"
 );
+
+impl SampleCount {
+    /// The grid side n (the count is n², checked when parsed).
+    pub fn side(self) -> u32 {
+        SamplePattern::side_for(self.0).unwrap_or(1)
+    }
+}
 
 /// Supersampling pattern names.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]

@@ -135,7 +135,7 @@ pub fn search(
     let flip = Flip::new(view.ppd() as f32);
     let sphere = job.original.mesh().bounding_sphere();
     let r_units = sphere.radius as f64;
-    let n = (config.samples.0 as f64).sqrt().round() as u32;
+    let n = config.samples.side();
     let mut probes: BTreeMap<u32, Probe> = BTreeMap::new();
     let mut probe = |diameter: u32| -> Result<Probe> {
         if let Some(p) = probes.get(&diameter) {

@@ -49,6 +49,8 @@ pub struct Outcome {
     pub failures: Vec<Failure>,
     /// The plan.
     pub plan: Plan,
+    /// What the user should know besides the gate (why `--backend auto` rendered on the CPU).
+    pub warnings: Vec<String>,
 }
 
 /// `shard.json`: what a (shard of a) run covered.
@@ -61,9 +63,13 @@ struct Manifest {
 }
 
 /// Run a config (one shard of it) and write every output.
-pub fn eval(config: &Path, options: &RunOptions) -> Result<Outcome> {
+pub fn eval(
+    config: &Path,
+    options: &RunOptions,
+    progress: &dyn crate::progress::Progress,
+) -> Result<Outcome> {
     let plan = Plan::load(config)?;
-    let out = run::run(plan, options)?;
+    let out = run::run(plan, options, progress)?;
     let manifest = Manifest {
         config_path: out.plan.config_path.clone(),
         config_text: out.plan.config_text.clone(),
@@ -75,7 +81,9 @@ pub fn eval(config: &Path, options: &RunOptions) -> Result<Outcome> {
             .filter(|c| options.shard.contains(c))
             .collect(),
     };
-    finish(out.plan, out.out_dir, out.results, &manifest)
+    let mut outcome = finish(out.plan, out.out_dir, out.results, &manifest)?;
+    outcome.warnings = out.warnings;
+    Ok(outcome)
 }
 
 /// Write the tables, gate, JUnit, report and manifest; returns the outcome.
@@ -98,6 +106,7 @@ fn finish(plan: Plan, out_dir: PathBuf, results: Results, manifest: &Manifest) -
         results,
         failures,
         plan,
+        warnings: Vec::new(),
     })
 }
 

@@ -27,6 +27,7 @@ use super::tables::{LodInfo, MetricRow, Results, higher_is_worse, round7};
 use crate::error::Result;
 use crate::mesh::{self, LoadOptions, Mesh, surface_distance};
 use crate::metric::{LinearImage, colormap};
+use crate::progress::Progress;
 use crate::raster::{self, RenderScene};
 use crate::scene::Scene;
 use crate::simplify::{self, Method};
@@ -38,8 +39,6 @@ pub struct RunOptions {
     pub out: Option<PathBuf>,
     /// The shard to run.
     pub shard: Shard,
-    /// Draw a progress bar (on a terminal, not quiet).
-    pub progress: bool,
     /// Where frames are rendered (`--backend`); default the CPU reference.
     pub backend: crate::backend::Backend,
 }
@@ -53,6 +52,8 @@ pub struct RunOutput {
     pub out_dir: PathBuf,
     /// The tables.
     pub results: Results,
+    /// What the user should know (why `--backend auto` rendered on the CPU).
+    pub warnings: Vec<String>,
 }
 
 /// A LOD ready to render.
@@ -69,7 +70,7 @@ const THUMB: u32 = 256;
 
 /// Run `plan`'s cases in `options.shard`, writing images into the output folder. The tables are
 /// returned (written by the caller with the other sinks).
-pub fn run(plan: Plan, options: &RunOptions) -> Result<RunOutput> {
+pub fn run(plan: Plan, options: &RunOptions, progress: &dyn Progress) -> Result<RunOutput> {
     let out_dir = plan
         .config
         .out_dir(&plan.config_path, options.out.as_deref());
@@ -93,7 +94,8 @@ pub fn run(plan: Plan, options: &RunOptions) -> Result<RunOutput> {
         .count();
     let views = cfg.render.rig.0.directions().len();
     let steps = cases * (views + usize::from(cfg.distance.enabled));
-    let bar = progress_bar(options.progress, steps as u64, "renders");
+    progress.start(Some(steps as u64), "renders", "");
+    let bar = progress;
     for asset in &plan.assets {
         let wanted: Vec<bool> = asset
             .lods
@@ -103,7 +105,7 @@ pub fn run(plan: Plan, options: &RunOptions) -> Result<RunOutput> {
         if !wanted.contains(&true) {
             continue;
         }
-        bar.set_message(asset.name.clone());
+        bar.set_message(&asset.name);
         let original = Arc::new(mesh::load(&asset.mesh, &LoadOptions::default())?);
         let reference = scene_for(cfg, original.clone());
         let geometry = (cfg.geometry_samples > 0)
@@ -158,7 +160,7 @@ pub fn run(plan: Plan, options: &RunOptions) -> Result<RunOutput> {
                             thumbnail(&heat),
                         ]
                     });
-                    bar.inc(1);
+                    bar.advance(1);
                     Ok((scored.values, thumbs))
                 })
                 .collect::<Result<Vec<_>>>()?;
@@ -209,7 +211,7 @@ pub fn run(plan: Plan, options: &RunOptions) -> Result<RunOutput> {
                 )?;
             }
             if cfg.distance.enabled {
-                bar.set_message(format!("{} {} distance", asset.name, lod.name));
+                bar.set_message(&format!("{} {} distance", asset.name, lod.name));
                 let take = cfg.distance.views.unwrap_or(3).max(1);
                 let directions = order
                     .iter()
@@ -230,17 +232,18 @@ pub fn run(plan: Plan, options: &RunOptions) -> Result<RunOutput> {
                     &cfg.viewing,
                     &settings,
                 )?);
-                bar.inc(1);
+                bar.advance(1);
             }
         }
         results.lods.extend(lods.into_iter().map(|l| l.info));
     }
-    bar.finish_and_clear();
+    bar.finish();
     results.sort(&plan.case_ids());
     Ok(RunOutput {
         plan,
         out_dir,
         results,
+        warnings: engine.fallback().map(str::to_string).into_iter().collect(),
     })
 }
 
@@ -394,34 +397,4 @@ fn thumbnail(img: &image::RgbImage) -> image::RgbImage {
         return img.clone();
     }
     image::imageops::resize(img, THUMB, THUMB, image::imageops::FilterType::Triangle)
-}
-
-/// A spinner with a message and the elapsed time, for work without a count; hidden when not
-/// `enabled`.
-pub(crate) fn spinner(enabled: bool, message: String) -> indicatif::ProgressBar {
-    if !enabled {
-        return indicatif::ProgressBar::hidden();
-    }
-    let bar = indicatif::ProgressBar::new_spinner().with_message(message);
-    if let Ok(style) =
-        indicatif::ProgressStyle::with_template("{spinner} [{elapsed_precise}] {msg}")
-    {
-        bar.set_style(style);
-    }
-    bar.enable_steady_tick(std::time::Duration::from_millis(120));
-    bar
-}
-
-/// A progress bar counting `unit`s, or a hidden one when not `enabled`.
-pub(crate) fn progress_bar(enabled: bool, len: u64, unit: &str) -> indicatif::ProgressBar {
-    if !enabled {
-        return indicatif::ProgressBar::hidden();
-    }
-    let bar = indicatif::ProgressBar::new(len);
-    if let Ok(style) = indicatif::ProgressStyle::with_template(&format!(
-        "{{spinner}} [{{elapsed_precise}}] {{bar:40}} {{pos}}/{{len}} {unit}  {{msg}}"
-    )) {
-        bar.set_style(style);
-    }
-    bar
 }

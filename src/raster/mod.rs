@@ -107,6 +107,15 @@ pub enum SamplePattern {
 }
 
 impl SamplePattern {
+    /// Largest grid side n (n × n = 64 samples per pixel).
+    pub const MAX_SIDE: u32 = 8;
+
+    /// The grid side n of `samples` per pixel: `Some(n)` when samples = n² with 1 ≤ n ≤
+    /// [`MAX_SIDE`](Self::MAX_SIDE). The one place the square-sample rule is checked.
+    pub fn side_for(samples: u32) -> Option<u32> {
+        (1..=Self::MAX_SIDE).find(|n| n * n == samples)
+    }
+
     /// Samples per pixel.
     pub fn count(self) -> usize {
         let n = match self {
@@ -192,10 +201,10 @@ impl RenderSettings {
         let n = match self.samples {
             SamplePattern::Ordered(n) | SamplePattern::Rotated(n) => n,
         };
-        if !(1..=8).contains(&n) {
+        if SamplePattern::side_for(n.saturating_mul(n)) != Some(n) {
             return Err(Error::Usage(format!(
                 "{} samples per pixel: use 1, 4, 9, ..., 64 (n×n with n ≤ 8)",
-                n * n
+                n.saturating_mul(n)
             )));
         }
         Ok(())

@@ -265,9 +265,10 @@ fn render_cli_writes_pngs_and_rejects_bad_requests() {
         (vec!["--size", "0"], "image size 0x0"),
         // Past the 16-bit pixel boxes of the set-up records (setup.rs).
         (vec!["--size", "16385"], "image size 16385x16385"),
-        (vec!["--rig", "cube"], "--rig cube"),
-        (vec!["--shading", "toon"], "--shading toon"),
-        (vec!["--samples", "3"], "--samples 3"),
+        // Flag values clap parses: the message names the flag and the value.
+        (vec!["--rig", "cube"], "'cube' for '--rig"),
+        (vec!["--shading", "toon"], "'toon' for '--shading"),
+        (vec!["--samples", "3"], "'3' for '--samples"),
         (vec!["--view", "20"], "--view 20"),
     ] {
         let bad = dir.path().join("bad.png");

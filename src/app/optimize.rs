@@ -1,0 +1,48 @@
+//! `lodeval optimize`: Lindstrom & Turk's image-driven optimization of a simplified mesh.
+
+use std::path::PathBuf;
+
+use crate::error::{Error, Result};
+use crate::mesh::{self, LoadOptions};
+
+/// What `lodeval optimize` does.
+#[derive(Debug, Clone)]
+pub struct OptimizeJob {
+    /// The original (target) mesh.
+    pub original: PathBuf,
+    /// The simplified mesh to improve.
+    pub simplified: PathBuf,
+    /// Output OBJ.
+    pub out: PathBuf,
+    /// Energy log CSV, if wanted.
+    pub energy_csv: Option<PathBuf>,
+    /// Optimizer settings.
+    pub options: crate::simplify::lindstrom_turk::Options,
+}
+
+/// Run the image-driven optimizer and write the mesh (and the energy log).
+pub fn optimize(
+    job: &OptimizeJob,
+    progress: &dyn crate::progress::Progress,
+) -> Result<crate::simplify::lindstrom_turk::Outcome> {
+    use crate::simplify::lindstrom_turk;
+    if job.out.extension().and_then(|e| e.to_str()) != Some("obj") {
+        return Err(Error::Usage(format!(
+            "-o {}: lodeval writes optimized meshes as .obj",
+            job.out.display()
+        )));
+    }
+    let original = std::sync::Arc::new(mesh::load(&job.original, &LoadOptions::default())?);
+    let simplified = std::sync::Arc::new(mesh::load(&job.simplified, &LoadOptions::default())?);
+    progress.start(Some(job.options.evals), "evaluations", "");
+    let outcome = lindstrom_turk::optimize(&original, &simplified, &job.options, &|n| {
+        progress.set_position(n)
+    });
+    progress.finish();
+    let outcome = outcome?;
+    crate::mesh::write_obj::write(&outcome.mesh, &job.out)?;
+    if let Some(path) = &job.energy_csv {
+        crate::io::csv::write_rows(path, None, &outcome.log)?;
+    }
+    Ok(outcome)
+}

@@ -1,0 +1,119 @@
+//! `lodeval render`: a mesh framed by its bounding sphere from one view, every view, or a contact
+//! sheet of all views, as PNG (and linear EXR).
+
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+use crate::error::{Error, Result};
+use crate::mesh::{self, LoadOptions};
+use crate::raster::{self, Frame, RenderScene, RenderSettings};
+use crate::scene::Rig;
+
+/// Which views `lodeval render` writes.
+#[derive(Debug, Clone, PartialEq)]
+pub enum ViewSelection {
+    /// One view, by number, to one file.
+    One {
+        /// View number within the rig.
+        view: usize,
+        /// Output PNG.
+        out: PathBuf,
+    },
+    /// Every view of the rig into a folder as `view-NN.png`.
+    All {
+        /// Output folder.
+        out_dir: PathBuf,
+    },
+    /// Every view of the rig tiled into one contact-sheet PNG.
+    Sheet {
+        /// Output PNG.
+        out: PathBuf,
+    },
+}
+
+/// A `lodeval render` request.
+#[derive(Debug, Clone)]
+pub struct RenderJob {
+    /// Mesh file.
+    pub mesh: PathBuf,
+    /// Loader options.
+    pub load: LoadOptions,
+    /// Render settings (size, samples, shading, culling).
+    pub settings: RenderSettings,
+    /// View rig.
+    pub rig: Rig,
+    /// Views and outputs.
+    pub views: ViewSelection,
+    /// Also write linear float EXR files beside each PNG.
+    pub exr: bool,
+    /// Where to render.
+    pub backend: crate::backend::Backend,
+}
+
+pub(crate) fn write_frame(path: &Path, frame: &Frame, exr: bool) -> Result<()> {
+    crate::io::write_image(path, &image::DynamicImage::ImageRgb8(frame.to_srgb8()))?;
+    if exr {
+        crate::io::write_image(
+            &path.with_extension("exr"),
+            &image::DynamicImage::ImageRgb32F(frame.to_rgb32f()),
+        )?;
+    }
+    Ok(())
+}
+
+/// What a render job did.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RenderReport {
+    /// The files written, in order.
+    pub written: Vec<PathBuf>,
+    /// What the user should know: the mesh's load warnings (`--missing-assets warn`) and why
+    /// `--backend auto` rendered on the CPU.
+    pub warnings: Vec<String>,
+}
+
+/// Run a render job.
+pub fn render(job: &RenderJob) -> Result<RenderReport> {
+    let mesh = Arc::new(mesh::load(&job.mesh, &job.load)?);
+    let scene = RenderScene::of(mesh.clone());
+    let aspect = job.settings.width as f32 / job.settings.height as f32;
+    let cameras = job.rig.cameras(&mesh, aspect);
+    let engine = crate::backend::Engine::new(job.backend)?;
+    let renderer = engine.scene(&scene)?;
+    let warnings = mesh
+        .warnings()
+        .iter()
+        .map(|w| format!("{}: {w}", job.mesh.display()))
+        .chain(engine.fallback().map(str::to_string))
+        .collect();
+    let mut written = Vec::new();
+    match &job.views {
+        ViewSelection::One { view, out } => {
+            let camera = cameras.get(*view).ok_or_else(|| {
+                Error::Usage(format!(
+                    "--view {view} does not exist: the rig has views 0..{}",
+                    cameras.len() - 1
+                ))
+            })?;
+            write_frame(out, &renderer.render(camera, &job.settings)?, job.exr)?;
+            written.push(out.clone());
+        }
+        ViewSelection::All { out_dir } => {
+            for (k, camera) in cameras.iter().enumerate() {
+                let out = out_dir.join(format!("view-{k:02}.png"));
+                write_frame(&out, &renderer.render(camera, &job.settings)?, job.exr)?;
+                written.push(out);
+            }
+        }
+        ViewSelection::Sheet { out } => {
+            let frames = cameras
+                .iter()
+                .map(|c| renderer.render(c, &job.settings).map(|f| f.to_srgb8()))
+                .collect::<Result<Vec<_>>>()?;
+            let columns = (frames.len() as f32).sqrt().ceil() as u32;
+            let sheet = raster::contact_sheet(&frames, columns, 4, [32, 32, 32]);
+            crate::io::write_image(out, &image::DynamicImage::ImageRgb8(sheet))?;
+            written.push(out.clone());
+        }
+    }
+    Ok(RenderReport { written, warnings })
+}

@@ -1,0 +1,179 @@
+//! `lodeval simplify`: a LOD (or a chain) by QEM, clustering, meshoptimizer or Williams et al.,
+//! written as OBJ with its materials and textures.
+
+use std::path::{Path, PathBuf};
+
+use crate::error::{Error, Result};
+use crate::mesh::{self, LoadOptions, Mesh};
+use crate::scene::{Camera, Rig};
+
+/// A `lodeval simplify` request.
+#[derive(Debug, Clone)]
+pub struct SimplifyJob {
+    /// Input mesh.
+    pub mesh: PathBuf,
+    /// Output `.obj` (with `--chain`: the stem; files become `STEM-rXX.obj`).
+    pub out: PathBuf,
+    /// Method.
+    pub method: crate::simplify::Method,
+    /// Goals (one, or the chain).
+    pub goals: Vec<crate::simplify::Goal>,
+    /// Write one file per goal with a suffix (a chain) rather than `out` itself.
+    pub chain: bool,
+}
+
+/// One written LOD.
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct SimplifyRow {
+    /// The file written.
+    pub file: PathBuf,
+    /// Triangles.
+    pub triangles: usize,
+    /// Over the input's triangles.
+    pub ratio: f64,
+    /// The simplifier's own error estimate, model units.
+    pub simplifier_error: Option<f64>,
+    /// Seconds for the whole chain (wall clock; reporting only).
+    pub seconds: f64,
+}
+
+/// Check that `out` is an OBJ path, then load `input` (the simplifiers' common start).
+fn load_for_lod(input: &Path, out: &Path) -> Result<Mesh> {
+    if out.extension().and_then(|e| e.to_str()) != Some("obj") {
+        return Err(Error::Usage(format!(
+            "-o {}: lodeval writes LODs as .obj (with .mtl and textures beside it)",
+            out.display()
+        )));
+    }
+    mesh::load(input, &LoadOptions::default())
+}
+
+/// Simplify a mesh and write the LOD(s) as OBJ.
+pub fn simplify(
+    job: &SimplifyJob,
+    progress: &dyn crate::progress::Progress,
+) -> Result<Vec<SimplifyRow>> {
+    let mesh = load_for_lod(&job.mesh, &job.out)?;
+    let start = std::time::Instant::now();
+    progress.start(
+        None,
+        "",
+        &format!(
+            "simplifying {} triangles with {}",
+            mesh.triangle_count(),
+            job.method.name()
+        ),
+    );
+    let lods = crate::simplify::chain(&mesh, job.method, &job.goals);
+    progress.finish();
+    let lods = lods?;
+    let seconds = start.elapsed().as_secs_f64();
+    let stem = job
+        .out
+        .file_stem()
+        .map_or_else(|| "lod".into(), |s| s.to_string_lossy().into_owned());
+    let mut rows = Vec::new();
+    for (lod, goal) in lods.iter().zip(&job.goals) {
+        let file = if job.chain {
+            let suffix = match goal {
+                crate::simplify::Goal::Ratio(r) => {
+                    format!("r{}", crate::eval::config::percent_label(*r))
+                }
+                crate::simplify::Goal::Triangles(t) => format!("t{t}"),
+                crate::simplify::Goal::Error(e) => format!("e{e}"),
+            };
+            job.out.with_file_name(format!("{stem}-{suffix}.obj"))
+        } else {
+            job.out.clone()
+        };
+        crate::mesh::write_obj::write(&lod.mesh, &file)?;
+        rows.push(SimplifyRow {
+            file,
+            triangles: lod.mesh.triangle_count(),
+            ratio: lod.mesh.triangle_count() as f64 / mesh.triangle_count() as f64,
+            simplifier_error: lod.error,
+            seconds,
+        });
+    }
+    Ok(rows)
+}
+
+/// Which views a Williams et al. LOD is made for.
+#[derive(Debug, Clone)]
+pub enum WilliamsViews {
+    /// View K of a rig (default framing).
+    One(Rig, usize),
+    /// One static LOD for every view of a rig.
+    All(Rig),
+    /// A camera at an eye position looking at a target (default: the model's centre), framed
+    /// with the default field of view.
+    Camera(glam::Vec3, Option<glam::Vec3>),
+}
+
+/// A `lodeval simplify --method williams` request.
+#[derive(Debug, Clone)]
+pub struct WilliamsJob {
+    /// Input mesh.
+    pub mesh: PathBuf,
+    /// Output `.obj`.
+    pub out: PathBuf,
+    /// A triangle budget, or a viewing distance (metres) from which the LOD is to be
+    /// imperceptible.
+    pub goal: crate::simplify::williams::StaticGoal,
+    /// Views.
+    pub views: WilliamsViews,
+    /// Shading the LOD is for.
+    pub shading: crate::raster::Shading,
+    /// Error criterion.
+    pub criterion: crate::simplify::williams::Criterion,
+    /// Image size (pixels) the views are seen at.
+    pub size: u32,
+}
+
+/// Simplify with Williams et al. 2003 and write the LOD as OBJ.
+pub fn simplify_williams(job: &WilliamsJob) -> Result<Vec<SimplifyRow>> {
+    use crate::simplify::williams::{Options, Williams};
+    let mesh = load_for_lod(&job.mesh, &job.out)?;
+    let start = std::time::Instant::now();
+    let w = Williams::build(&mesh)?;
+    let opts = Options {
+        shading: job.shading,
+        criterion: job.criterion,
+        size: (job.size, job.size),
+        ..Options::default()
+    };
+    let cameras = match &job.views {
+        WilliamsViews::All(rig) => rig.cameras(&mesh, 1.0),
+        WilliamsViews::One(rig, k) => {
+            let cams = rig.cameras(&mesh, 1.0);
+            vec![*cams.get(*k).ok_or_else(|| {
+                Error::Usage(format!("--view {k}: the rig has views 0..{}", cams.len()))
+            })?]
+        }
+        WilliamsViews::Camera(eye, target) => {
+            let sphere = mesh.bounding_sphere();
+            let target = target.unwrap_or(sphere.center);
+            if !(eye.is_finite() && target.is_finite()) || eye.distance(target) <= 0.0 {
+                return Err(Error::Usage(
+                    "--camera: the eye must be finite and apart from the target".into(),
+                ));
+            }
+            vec![Camera::looking_at(
+                sphere,
+                *eye,
+                target,
+                Camera::DEFAULT_FOV_Y_DEG,
+            )]
+        }
+    };
+    let lod = w.static_lod(&cameras, job.goal, &opts)?;
+    let seconds = start.elapsed().as_secs_f64();
+    crate::mesh::write_obj::write(&lod, &job.out)?;
+    Ok(vec![SimplifyRow {
+        file: job.out.clone(),
+        triangles: lod.triangle_count(),
+        ratio: lod.triangle_count() as f64 / mesh.triangle_count() as f64,
+        simplifier_error: None,
+        seconds,
+    }])
+}

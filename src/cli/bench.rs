@@ -1,0 +1,212 @@
+//! `lodeval bench WHAT`: the benchmarks, printed as Markdown tables or JSON rows. Reporting only.
+
+use std::path::PathBuf;
+
+use clap::{Args, ValueEnum};
+use lodeval::raster::Shading;
+use lodeval::{Error, LoadOptions};
+
+use super::args::{BackendArg, parse_samples, parse_shading};
+use super::print::{emit, emit_json};
+
+/// What `lodeval bench` measures.
+#[derive(Copy, Clone, Debug, PartialEq, Eq, ValueEnum)]
+pub(crate) enum BenchTarget {
+    /// The rasterizer on a large torus (1 and 4 samples), and region re-renders.
+    Raster,
+    /// FLIP, the VDP, SSIM and PSNR on REF TEST.
+    Metrics,
+    /// QEM, clustering and meshoptimizer on MESH..., in turns.
+    Simplify,
+    /// Williams et al.'s preprocessing and per-frame cut adaptation on MESH....
+    Williams,
+    /// The image-driven optimizer's evaluations per second on our QEM LOD of MESH....
+    Optimize,
+}
+
+#[derive(Args, Debug)]
+pub(crate) struct BenchArgs {
+    /// What to measure: `raster`, `metrics REF TEST`, `simplify MESH...`, `williams MESH...` or
+    /// `optimize MESH...` (the image-driven optimizer's evaluations per second, 20 views at 256²,
+    /// on our QEM LOD of each mesh).
+    #[arg(value_enum)]
+    pub(crate) what: BenchTarget,
+    /// For `metrics`: the reference and test images; for `simplify`, `williams` and `optimize`:
+    /// the meshes.
+    pub(crate) images: Vec<PathBuf>,
+    /// For `optimize`: the LOD's triangle count.
+    #[arg(long, default_value_t = 1400)]
+    pub(crate) triangles: usize,
+    /// For `optimize`: energy evaluations per timed run.
+    #[arg(long, default_value_t = 20_000)]
+    pub(crate) evals: u64,
+    /// For `simplify`: target ratios, comma separated.
+    #[arg(long, value_delimiter = ',', default_value = "0.5,0.1,0.01")]
+    pub(crate) ratios: Vec<f64>,
+    /// For `simplify`: also a procedural bumpy sphere of 20·4^N triangles (0: none).
+    #[arg(long, default_value_t = 0)]
+    pub(crate) bumpy: u32,
+    /// For `metrics`: timed runs per metric; for `simplify`: timed runs per method and ratio
+    /// (best and median reported); for `optimize`: timed optimizer runs per mesh.
+    #[arg(long, default_value_t = 5)]
+    pub(crate) runs: usize,
+    /// Torus rings (triangles = 2 · rings · sides).
+    #[arg(long, default_value_t = 1000)]
+    pub(crate) rings: u32,
+    /// Torus sides.
+    #[arg(long, default_value_t = 500)]
+    pub(crate) sides: u32,
+    /// Image edge in pixels.
+    #[arg(long, default_value_t = 1024)]
+    pub(crate) size: u32,
+    /// Number of views (Fibonacci rig).
+    #[arg(long, default_value_t = 20)]
+    pub(crate) views: u32,
+    /// Samples per pixel to measure, comma separated (squares: 1, 4, 9, ..., 64).
+    #[arg(long, value_delimiter = ',', default_value = "1,4", value_parser = parse_samples)]
+    pub(crate) samples: Vec<u32>,
+    /// Shading model.
+    #[arg(long, default_value = "gouraud", value_parser = parse_shading)]
+    pub(crate) shading: Shading,
+    /// Print JSON rows instead of a table.
+    #[arg(long)]
+    pub(crate) json: bool,
+    /// Also export the benchmark scene to this folder (for benches/llvmpipe_raster.py).
+    #[arg(long)]
+    pub(crate) export: Option<PathBuf>,
+    /// Renderer to time: cpu, gpu or auto.
+    #[arg(long, value_enum, default_value_t = BackendArg::Cpu)]
+    pub(crate) backend: BackendArg,
+}
+
+/// Load each mesh, named by its file stem (for the benchmarks' tables).
+fn named_meshes(paths: &[PathBuf]) -> Result<Vec<(String, lodeval::mesh::Mesh)>, Error> {
+    paths
+        .iter()
+        .map(|p| {
+            let name = p
+                .file_stem()
+                .map_or_else(String::new, |s| s.to_string_lossy().into_owned());
+            Ok((name, lodeval::mesh::load(p, &LoadOptions::DEFAULT)?))
+        })
+        .collect()
+}
+
+/// Run `bench`.
+pub(crate) fn run(a: BenchArgs) -> Result<(), Error> {
+    if a.what == BenchTarget::Metrics {
+        let [reference, test] = a.images.as_slice() else {
+            return Err(Error::Usage(
+                "lodeval bench metrics REF TEST: give two images".into(),
+            ));
+        };
+        let rows = lodeval::app::bench::bench_metrics(reference, test, a.runs)?;
+        return emit_json(&rows);
+    }
+    if a.what == BenchTarget::Williams {
+        let mut t = String::from(
+            "| mesh | triangles | MT nodes | hierarchy s | preprocess s | budget | frames | adapt ms median | p95 | max | first frame ms | nodes changed per frame (median) |\n|---|---|---|---|---|---|---|---|---|---|---|---|\n",
+        );
+        for (name, mesh) in named_meshes(&a.images)? {
+            for r in lodeval::app::bench::bench_williams(&mesh, &a.ratios, a.views)? {
+                t.push_str(&format!(
+                    "| {name} | {} | {} | {:.2} | {:.2} | {} | {} | {:.2} | {:.2} | {:.2} | {:.2} | {} |\n",
+                    r.triangles,
+                    r.nodes,
+                    r.hierarchy_seconds,
+                    r.preprocess_seconds,
+                    r.budget,
+                    r.frames,
+                    r.median_ms,
+                    r.p95_ms,
+                    r.max_ms,
+                    r.first_ms,
+                    r.median_changes
+                ));
+            }
+        }
+        return emit(&t);
+    }
+    if a.what == BenchTarget::Optimize {
+        let meshes = named_meshes(&a.images)?;
+        if meshes.is_empty() {
+            return Err(Error::Usage(
+                "lodeval bench optimize MESH...: give at least one mesh".into(),
+            ));
+        }
+        let rows = lodeval::app::bench::bench_optimize(&meshes, a.triangles, a.evals, a.runs)?;
+        if a.json {
+            return emit_json(&rows);
+        }
+        let mut t = String::from(
+            "| mesh | input triangles | LOD triangles | LOD vertices | views | size | threads | evaluations | runs | best /s | median /s | worst /s | set-up s |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|\n",
+        );
+        for r in &rows {
+            t.push_str(&format!(
+                "| {} | {} | {} | {} | {} | {} | {} | {} | {} | {:.0} | {:.0} | {:.0} | {:.2} |\n",
+                r.mesh,
+                r.input_triangles,
+                r.triangles,
+                r.vertices,
+                r.views,
+                r.size,
+                r.threads,
+                r.evaluations,
+                r.runs,
+                r.best_per_s,
+                r.median_per_s,
+                r.worst_per_s,
+                r.setup_seconds
+            ));
+        }
+        return emit(&t);
+    }
+    if a.what == BenchTarget::Simplify {
+        let mut meshes = named_meshes(&a.images)?;
+        if a.bumpy > 0 {
+            meshes.push((
+                format!("bumpy-sphere-s{}", a.bumpy),
+                lodeval::mesh::shapes::bumpy_sphere(a.bumpy),
+            ));
+        }
+        let rows = lodeval::app::bench::bench_simplify(&meshes, &a.ratios, 1_000_000, a.runs)?;
+        if a.json {
+            return emit_json(&rows);
+        }
+        let mut t = String::from(
+            "| mesh | input triangles | method | ratio | triangles | best s | median s | M input tri/s (best) | Hausdorff / diagonal | mean / diagonal |\n|---|---|---|---|---|---|---|---|---|---|\n",
+        );
+        for r in &rows {
+            t.push_str(&format!(
+                "| {} | {} | {} | {} | {} | {:.4} | {:.4} | {:.2} | {:.3e} | {:.3e} |\n",
+                r.mesh,
+                r.input_triangles,
+                r.method,
+                r.ratio,
+                r.triangles,
+                r.seconds,
+                r.median_seconds,
+                r.mtri_per_s,
+                r.hausdorff_relative,
+                r.mean_relative
+            ));
+        }
+        return emit(&t);
+    }
+    let job = lodeval::app::bench::RasterBench {
+        rings: a.rings,
+        sides: a.sides,
+        size: a.size,
+        views: a.views,
+        samples: a.samples,
+        shading: a.shading,
+        export: a.export,
+        backend: a.backend.into(),
+    };
+    let rows = lodeval::app::bench::bench_raster(&job)?;
+    let rss = lodeval::app::bench::peak_rss_mib().unwrap_or(f64::NAN);
+    if a.json {
+        return emit_json(&rows);
+    }
+    emit(&(lodeval::app::bench::raster_bench_table(&rows) + &format!("peak RSS: {rss:.0} MiB\n")))
+}

@@ -1,0 +1,42 @@
+//! `lodeval eval CONFIG`: the batch evaluation and its gate.
+
+use std::path::PathBuf;
+
+use clap::Args;
+use lodeval::Error;
+
+use super::args::BackendArg;
+use super::print::gate_result;
+use super::progress::Reporter;
+
+#[derive(Args, Debug)]
+pub(crate) struct EvalArgs {
+    /// The batch config (TOML; see configs/README.md).
+    pub(crate) config: PathBuf,
+    /// Output folder (default: the config's `out`, else ../results/<config name> beside it).
+    #[arg(long, value_name = "DIR")]
+    pub(crate) out: Option<PathBuf>,
+    /// Run one shard: INDEX/COUNT, 0-based (also from TEST_SHARD_INDEX/TEST_TOTAL_SHARDS,
+    /// CI_NODE_INDEX/CI_NODE_TOTAL, JOB_COMPLETION_INDEX with LODEVAL_SHARD_COUNT).
+    #[arg(long, value_name = "INDEX/COUNT")]
+    pub(crate) shard: Option<String>,
+    /// Renderer and FLIP/MSE kernels: cpu, gpu or auto (recorded in the CSVs and the report).
+    #[arg(long, value_enum, default_value_t = BackendArg::Cpu)]
+    pub(crate) backend: BackendArg,
+}
+
+/// Run `eval`.
+pub(crate) fn run(a: EvalArgs, quiet: bool) -> Result<(), Error> {
+    let shard = match &a.shard {
+        Some(s) => lodeval::eval::Shard::parse(s)?,
+        None => lodeval::eval::Shard::from_env(|k| std::env::var(k).ok())?
+            .unwrap_or(lodeval::eval::Shard::ALL),
+    };
+    let options = lodeval::eval::RunOptions {
+        out: a.out,
+        shard,
+        backend: a.backend.into(),
+    };
+    let outcome = lodeval::eval::eval(&a.config, &options, &Reporter::new(quiet))?;
+    gate_result(&outcome)
+}

@@ -1,0 +1,95 @@
+//! The `lodeval` command line (binary only): clap's argument structs, one file per command, each
+//! with its `*Args` and a `run` that turns them into a library job, calls it and prints what comes
+//! back; `args.rs` holds the value types several commands share, `print.rs` the output, and
+//! `progress.rs` the terminal and log progress reporter the library's jobs report through.
+
+mod args;
+mod bench;
+mod calibrate;
+mod diff;
+mod eval;
+mod geometry;
+mod golden;
+mod info;
+mod merge;
+mod optimize;
+mod print;
+mod progress;
+mod render;
+mod simplify;
+
+use clap::{Parser, Subcommand};
+use lodeval::Error;
+
+/// The command line.
+#[derive(Parser, Debug)]
+#[command(
+    name = "lodeval",
+    version,
+    about = "Does a simplified mesh still look like the original, and from how far away can nobody tell them apart?"
+)]
+pub(crate) struct Cli {
+    /// Worker threads (default: all cores). Results are identical for any value.
+    #[arg(long, global = true, value_name = "N")]
+    threads: Option<usize>,
+    /// No progress output.
+    #[arg(long, short, global = true)]
+    quiet: bool,
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand, Debug)]
+enum Command {
+    /// Print what a mesh file contains: counts, attributes, materials, textures, bounds.
+    Info(info::InfoArgs),
+    /// Render a mesh from the views of a rig with the CPU rasterizer.
+    Render(render::RenderArgs),
+    /// Compare two images with the perceptual metrics.
+    Diff(diff::DiffArgs),
+    /// Run a batch evaluation config: render, score, write CSVs, heat maps, report; gate.
+    Eval(eval::EvalArgs),
+    /// Compare renders with golden images, or bless new ones.
+    Golden(golden::GoldenArgs),
+    /// Simplify a mesh (QEM edge collapse, vertex clustering, meshoptimizer or Williams et al.)
+    /// and write OBJ.
+    Simplify(simplify::SimplifyArgs),
+    /// Image-driven optimization of a simplified mesh (Lindstrom & Turk): same vertex count,
+    /// renderings closer to the original's.
+    Optimize(optimize::OptimizeArgs),
+    /// Geometric error between two meshes: Hausdorff, mean and RMS surface distance (Metro-style).
+    Geometry(geometry::GeometryArgs),
+    /// Run a benchmark and print its table.
+    Bench(bench::BenchArgs),
+    /// Merge the outputs of sharded runs into what one machine would have written.
+    Merge(merge::MergeArgs),
+    /// Check the visible-difference predictor against observers' detection thresholds.
+    Calibrate(calibrate::CalibrateArgs),
+}
+
+/// Set up the worker threads and run the command.
+pub(crate) fn run(cli: Cli) -> Result<(), Error> {
+    if let Some(n) = cli.threads {
+        if n == 0 {
+            return Err(Error::Usage("--threads must be at least 1".into()));
+        }
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(n)
+            .build_global()
+            .map_err(|e| Error::Internal(format!("cannot start {n} worker threads: {e}")))?;
+    }
+    let quiet = cli.quiet;
+    match cli.command {
+        Command::Info(a) => info::run(a),
+        Command::Render(a) => render::run(a, quiet),
+        Command::Diff(a) => diff::run(a),
+        Command::Eval(a) => eval::run(a, quiet),
+        Command::Golden(a) => golden::run(a),
+        Command::Simplify(a) => simplify::run(a, quiet),
+        Command::Optimize(a) => optimize::run(a, quiet),
+        Command::Geometry(a) => geometry::run(a),
+        Command::Bench(a) => bench::run(a),
+        Command::Merge(a) => merge::run(a),
+        Command::Calibrate(a) => calibrate::run(a),
+    }
+}

@@ -1,0 +1,287 @@
+//! `lodeval simplify MESH -o OUT.obj`: a LOD or a chain by any method, and Williams et al.'s
+//! experiment (`--experiment`).
+
+use std::path::PathBuf;
+
+use clap::{Args, ValueEnum};
+use lodeval::Error;
+use lodeval::raster::Shading;
+use lodeval::scene::Rig;
+use lodeval::simplify::Method;
+use lodeval::simplify::williams::Criterion;
+
+use super::args::{parse_rig, parse_shading};
+use super::print::{emit, emit_json};
+use super::progress::Reporter;
+
+/// `--method`.
+#[derive(Copy, Clone, Debug, PartialEq, Eq, ValueEnum)]
+pub(crate) enum MethodArg {
+    /// Our edge collapse with Garland–Heckbert quadrics.
+    Qem,
+    /// Rossignac–Borrel vertex clustering.
+    Cluster,
+    /// meshoptimizer's index-only simplification.
+    Meshopt,
+    /// meshoptimizer moving vertices and attributes, as qem does.
+    #[value(name = "meshopt-update")]
+    MeshoptUpdate,
+    /// Williams et al. 2003: perceptual, view-dependent, to a --budget or --distance.
+    Williams,
+}
+
+impl MethodArg {
+    /// The library's method.
+    fn method(self) -> Method {
+        match self {
+            MethodArg::Qem => Method::Qem,
+            MethodArg::Cluster => Method::Cluster,
+            MethodArg::Meshopt => Method::Meshopt,
+            MethodArg::MeshoptUpdate => Method::MeshoptUpdate,
+            MethodArg::Williams => Method::Williams,
+        }
+    }
+}
+
+/// `--criterion` (Williams et al. §6's comparisons).
+#[derive(Copy, Clone, Debug, PartialEq, Eq, ValueEnum)]
+pub(crate) enum CriterionArg {
+    /// The paper's imperceptibility distance.
+    Perceptual,
+    /// View-independent object-space texture deviation.
+    ObjectSpace,
+    /// Texture deviation projected to pixels.
+    ScreenSpace,
+    /// Screen-space deviation, ×10 on the silhouette.
+    #[value(name = "silhouette-10")]
+    Silhouette10,
+}
+
+impl CriterionArg {
+    /// The library's criterion.
+    fn criterion(self) -> Criterion {
+        match self {
+            CriterionArg::Perceptual => Criterion::Perceptual,
+            CriterionArg::ObjectSpace => Criterion::ObjectSpace,
+            CriterionArg::ScreenSpace => Criterion::ScreenSpace,
+            CriterionArg::Silhouette10 => Criterion::Silhouette10,
+        }
+    }
+}
+
+#[derive(Args, Debug)]
+pub(crate) struct SimplifyArgs {
+    /// The mesh to simplify.
+    #[arg(required_unless_present = "experiment")]
+    pub(crate) mesh: Option<PathBuf>,
+    /// Output .obj (with --chain: files STEM-rXX.obj beside it).
+    #[arg(short, long, required_unless_present = "experiment")]
+    pub(crate) out: Option<PathBuf>,
+    /// Run Williams et al. 2003's evaluation from a config (configs/papers/williams2003.toml).
+    #[arg(long, conflicts_with_all = ["mesh", "out"])]
+    pub(crate) experiment: Option<PathBuf>,
+    /// qem (our edge collapse, Garland–Heckbert quadrics), cluster (Rossignac–Borrel), meshopt,
+    /// meshopt-update (meshoptimizer moving vertices and attributes, as qem does), or williams
+    /// (Williams et al. 2003: perceptual, view-dependent, to a --budget).
+    #[arg(long, value_enum, default_value_t = MethodArg::Qem)]
+    pub(crate) method: MethodArg,
+    /// williams: triangle budget.
+    #[arg(long, conflicts_with_all = ["ratio", "triangles", "error", "chain", "distance"])]
+    pub(crate) budget: Option<usize>,
+    /// williams: instead of a budget, refine until the LOD is imperceptible from this viewing
+    /// distance in metres (the display and viewer of the default viewing conditions).
+    #[arg(long, conflicts_with_all = ["ratio", "triangles", "error", "chain"])]
+    pub(crate) distance: Option<f64>,
+    /// williams: the camera, as EX,EY,EZ (looking at the model's centre, default field of view) or
+    /// EX,EY,EZ,TX,TY,TZ. Default: view 0 of the default rig at the default framing.
+    #[arg(long, value_delimiter = ',', num_args = 1, conflicts_with_all = ["view", "all_views"])]
+    pub(crate) camera: Vec<f32>,
+    /// williams: use view K of --rig.
+    #[arg(long, conflicts_with = "all_views")]
+    pub(crate) view: Option<usize>,
+    /// williams: one static LOD for every view of --rig (each node keyed by its worst view).
+    #[arg(long)]
+    pub(crate) all_views: bool,
+    /// williams: view rig for --view and --all-views.
+    #[arg(long, default_value = "dodecahedron", value_parser = parse_rig)]
+    pub(crate) rig: Rig,
+    /// williams: the shading the LOD is for (gouraud, phong, normal-mapped, unlit).
+    #[arg(long, default_value = "gouraud", value_parser = parse_shading)]
+    pub(crate) shading: Shading,
+    /// williams: perceptual, object-space, screen-space or silhouette-10.
+    #[arg(long, value_enum, default_value_t = CriterionArg::Perceptual)]
+    pub(crate) criterion: CriterionArg,
+    /// williams: image size the views are rendered at (pixels).
+    #[arg(long, default_value_t = 512)]
+    pub(crate) size: u32,
+    /// Target ratio of the input's triangles.
+    #[arg(long, conflicts_with_all = ["triangles", "error", "chain"])]
+    pub(crate) ratio: Option<f64>,
+    /// Target triangle count: the LOD has at most this many triangles (unless the mesh
+    /// cannot be simplified that far).
+    #[arg(long, conflicts_with_all = ["error", "chain"])]
+    pub(crate) triangles: Option<usize>,
+    /// Target error relative to the bounding-box diagonal (qem, meshopt).
+    #[arg(long, conflicts_with = "chain")]
+    pub(crate) error: Option<f64>,
+    /// A chain of ratios, e.g. 0.5,0.25,0.1.
+    #[arg(long, value_delimiter = ',')]
+    pub(crate) chain: Vec<f64>,
+    /// Print JSON.
+    #[arg(long)]
+    pub(crate) json: bool,
+}
+
+/// Run `simplify`.
+pub(crate) fn run(a: SimplifyArgs, quiet: bool) -> Result<(), Error> {
+    if let Some(config) = &a.experiment {
+        let rows =
+            lodeval::experiments::williams2003::run(config, &mut |line| eprintln!("{line}"))?;
+        eprintln!("{} curve points written", rows.len());
+        return Ok(());
+    }
+    if a.method == MethodArg::Williams {
+        let rows = lodeval::app::simplify_williams(&williams_job(&a)?)?;
+        if a.json {
+            return emit_json(&rows);
+        }
+        for r in &rows {
+            println!(
+                "{}  {} triangles ({:.4} of the input)",
+                r.file.display(),
+                r.triangles,
+                r.ratio
+            );
+        }
+        return Ok(());
+    }
+    use lodeval::simplify::Goal;
+    let method = a.method.method();
+    let unit = |r: f64, what: &str| {
+        if r > 0.0 && r <= 1.0 {
+            Ok(r)
+        } else {
+            Err(Error::Usage(format!("{what} {r}: use a value in (0, 1]")))
+        }
+    };
+    let goals: Vec<Goal> = if !a.chain.is_empty() {
+        a.chain
+            .iter()
+            .map(|&r| unit(r, "--chain").map(Goal::Ratio))
+            .collect::<Result<_, _>>()?
+    } else if let Some(r) = a.ratio {
+        vec![Goal::Ratio(unit(r, "--ratio")?)]
+    } else if let Some(t) = a.triangles {
+        vec![Goal::Triangles(t.max(1))]
+    } else if let Some(e) = a.error {
+        vec![Goal::Error(unit(e, "--error")?)]
+    } else {
+        return Err(Error::Usage(
+            "give --ratio R, --triangles N, --error E or --chain R1,R2,...".into(),
+        ));
+    };
+    let job = lodeval::app::SimplifyJob {
+        mesh: a.mesh.expect("clap requires it"),
+        out: a.out.expect("clap requires it"),
+        method,
+        chain: !a.chain.is_empty(),
+        goals: goals.clone(),
+    };
+    let rows = lodeval::app::simplify(&job, &Reporter::new(quiet))?;
+    warn_short_of_goals(&rows, &goals, method.name());
+    if a.json {
+        return emit_json(&rows);
+    }
+    let mut text = String::new();
+    for r in &rows {
+        text.push_str(&format!(
+            "{}  {} triangles ({:.4} of the input), simplifier error {}\n",
+            r.file.display(),
+            r.triangles,
+            r.ratio,
+            r.simplifier_error
+                .map_or_else(|| "-".to_string(), |e| format!("{e:.3e}"))
+        ));
+    }
+    emit(&text)
+}
+
+/// Tell the user (stderr) when a LOD stopped well above its triangle goal: the simplifier ran out
+/// of collapses it may make, and the file holds less simplification than asked for.
+fn warn_short_of_goals(
+    rows: &[lodeval::app::SimplifyRow],
+    goals: &[lodeval::simplify::Goal],
+    method: &str,
+) {
+    use lodeval::simplify::Goal;
+    for (r, g) in rows.iter().zip(goals) {
+        let input = r.triangles as f64 / r.ratio.max(f64::MIN_POSITIVE);
+        let target = match *g {
+            Goal::Ratio(x) => (x * input).round(),
+            Goal::Triangles(n) => n as f64,
+            Goal::Error(_) => continue,
+        };
+        if r.triangles as f64 > 1.05 * target + 2.0 {
+            eprintln!(
+                "warning: {}: {method} stopped at {} triangles, short of the goal of {target}: \
+                 every remaining collapse would change the surface's topology or fold it over \
+                 (closed parts are not collapsed away, borders only shrink along themselves). Ask \
+                 for less reduction, or try another --method.",
+                r.file.display(),
+                r.triangles
+            );
+        }
+    }
+}
+
+/// The `simplify --method williams` request from its arguments.
+pub(crate) fn williams_job(a: &SimplifyArgs) -> Result<lodeval::app::WilliamsJob, Error> {
+    use lodeval::app::WilliamsViews;
+    let rig = a.rig.clone();
+    let views = match (a.camera.len(), a.all_views) {
+        (0, true) => WilliamsViews::All(rig),
+        (0, false) => WilliamsViews::One(rig, a.view.unwrap_or(0)),
+        (3, _) => {
+            WilliamsViews::Camera(glam::Vec3::new(a.camera[0], a.camera[1], a.camera[2]), None)
+        }
+        (6, _) => WilliamsViews::Camera(
+            glam::Vec3::new(a.camera[0], a.camera[1], a.camera[2]),
+            Some(glam::Vec3::new(a.camera[3], a.camera[4], a.camera[5])),
+        ),
+        (n, _) => {
+            return Err(Error::Usage(format!(
+                "--camera takes 3 numbers (eye) or 6 (eye, target), not {n}"
+            )));
+        }
+    };
+    use lodeval::simplify::williams::StaticGoal;
+    let goal = match (a.budget, a.distance) {
+        (Some(b), _) => StaticGoal::Budget(b),
+        (None, Some(d)) if d.is_finite() && d > 0.0 => StaticGoal::Distance(d),
+        (None, Some(d)) => {
+            return Err(Error::Usage(format!(
+                "--distance {d}: give a positive distance in metres"
+            )));
+        }
+        (None, None) => {
+            return Err(Error::Usage(
+                "--method williams needs --budget N (triangles) or --distance METRES".into(),
+            ));
+        }
+    };
+    if a.size == 0 || a.size > 16384 {
+        return Err(Error::Usage(format!(
+            "--size {}: use 1..16384 pixels",
+            a.size
+        )));
+    }
+    Ok(lodeval::app::WilliamsJob {
+        mesh: a.mesh.clone().expect("clap requires it"),
+        out: a.out.clone().expect("clap requires it"),
+        goal,
+        views,
+        shading: a.shading,
+        criterion: a.criterion.criterion(),
+        size: a.size,
+    })
+}
