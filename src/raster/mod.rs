@@ -21,12 +21,12 @@
 
 mod bin;
 mod clip;
-mod crew;
+
 mod edge;
 mod fixed;
 mod frame;
-pub mod luminance;
-mod plane_run;
+pub mod incremental;
+
 mod prepare;
 mod recycle;
 mod region;

@@ -84,7 +84,7 @@ pub fn bench_optimize(
             vertices: input.welded_vertex_count(),
             views: options.views,
             size: options.size,
-            threads: crate::raster::luminance::crew_threads(),
+            threads: crate::raster::incremental::crew_threads(),
             evaluations: evals,
             runs: rates.len(),
             best_per_s: rates[rates.len() - 1],

@@ -14,7 +14,7 @@ use glam::{Vec2, Vec3};
 use super::Options;
 use super::simplex;
 use crate::mesh::adjacency::{Adjacency, Undo, Wedge};
-use crate::raster::luminance::{Change, LumaViews};
+use crate::raster::incremental::{Change, LumaViews};
 
 /// How normals are treated.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Deserialize, serde::Serialize)]

@@ -39,7 +39,7 @@ use crate::error::{Error, Result};
 use crate::mesh::Mesh;
 use crate::mesh::adjacency::Adjacency;
 use crate::raster::RenderScene;
-use crate::raster::luminance::LumaViews;
+use crate::raster::incremental::LumaViews;
 use crate::scene::{Camera, Rig};
 
 /// Edges per iteration of the outer loop.

@@ -360,7 +360,7 @@ mod tests {
     use super::super::{Optimizer, Options, Setup, Targets};
     use super::*;
     use crate::mesh::Mesh;
-    use crate::raster::luminance::LumaViews;
+    use crate::raster::incremental::LumaViews;
 
     /// The shipped (smooth-shaded) Stanford bunny and a QEM version of about 150 vertices, with a
     /// small optimizer (6 views of 64²). (Not a flat-shaded input: there every edge is an

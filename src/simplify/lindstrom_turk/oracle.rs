@@ -10,7 +10,7 @@
 use glam::Vec3;
 use rayon::prelude::*;
 
-use crate::raster::luminance::LumaViews;
+use crate::raster::incremental::LumaViews;
 
 /// Box-blur radius in pixels.
 pub const BLUR_RADIUS: usize = 3;
