@@ -14,7 +14,7 @@
 
 use std::time::Instant;
 
-use lodeval::mesh::adjacency::Adjacency;
+use lodeval::mesh::edit::Adjacency;
 use lodeval::mesh::{LoadOptions, Mesh};
 use lodeval::simplify::{self, Goal, Method, qem};
 

@@ -1,5 +1,5 @@
 //! Per-vertex lists of incident triangles, kept sorted ascending and packed into one arena: the
-//! vertex → triangle side of [`super::adjacency::Adjacency`].
+//! vertex → triangle side of [`super::edit::Adjacency`].
 //!
 //! Decision: one `Vec<u32>` for every list, with a start, a length and a capacity per vertex,
 //! instead of one `Vec<u32>` per vertex. A mesh of 36 000 vertices then builds with one counting

@@ -21,8 +21,8 @@
 //!   [`MissingAssets::Warn`] the material keeps its base colour and a warning is recorded in
 //!   [`Mesh::warnings`].
 
-pub mod adjacency;
 mod bounds;
+pub mod edit;
 mod gltf;
 mod incidence;
 mod normals;

@@ -26,7 +26,7 @@
 
 use glam::{DVec3, Vec2, Vec3};
 
-use crate::mesh::adjacency::{Adjacency, Wedge};
+use crate::mesh::edit::{Adjacency, Wedge};
 
 /// Model units per unit of UV, as a fraction of the diagonal.
 pub const UV_SCALE: f64 = 0.5;

@@ -18,7 +18,7 @@ use glam::Vec3;
 
 use crate::error::Result;
 use crate::mesh::Mesh;
-use crate::mesh::adjacency::Adjacency;
+use crate::mesh::edit::Adjacency;
 
 /// Cluster with `cells` cells along the bounding box's longest axis.
 pub fn cluster(mesh: &Mesh, cells: u32) -> Result<Mesh> {

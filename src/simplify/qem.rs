@@ -43,7 +43,7 @@ use super::attributes::AttributeQuadrics;
 use super::queue::{Keyed, Lookahead};
 use crate::error::Result;
 use crate::mesh::Mesh;
-use crate::mesh::adjacency::{Adjacency, Local, VertexClass, Wedge};
+use crate::mesh::edit::{Adjacency, Local, VertexClass, Wedge};
 
 /// Weight of border constraint planes (× edge length²).
 pub const BORDER_WEIGHT: f64 = 1000.0;

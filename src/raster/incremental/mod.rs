@@ -87,7 +87,7 @@ use super::shade::{ResolvedLight, light_terms, source_barycentrics};
 use super::texture::MipTexture;
 use super::{camera_setup, fixed, rect_union as union};
 use crate::error::{Error, Result};
-use crate::mesh::adjacency::Adjacency;
+use crate::mesh::edit::Adjacency;
 use crate::prefetch::{prefetch, prefetch_at};
 use crate::scene::Camera;
 

@@ -13,7 +13,7 @@ use glam::{Vec2, Vec3};
 
 use super::Options;
 use super::simplex;
-use crate::mesh::adjacency::{Adjacency, Undo, Wedge};
+use crate::mesh::edit::{Adjacency, Undo, Wedge};
 use crate::raster::incremental::{Change, LumaViews};
 
 /// How normals are treated.

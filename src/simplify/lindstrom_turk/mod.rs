@@ -37,7 +37,7 @@ use stats::{Move, Stats};
 
 use crate::error::{Error, Result};
 use crate::mesh::Mesh;
-use crate::mesh::adjacency::Adjacency;
+use crate::mesh::edit::Adjacency;
 use crate::raster::RenderScene;
 use crate::raster::incremental::LumaViews;
 use crate::scene::{Camera, Rig};

@@ -138,12 +138,7 @@ impl Optimizer {
     }
 
     /// Accept or reject the pending change; returns the committed ΔE.
-    fn settle(
-        &mut self,
-        delta: i64,
-        undo: Option<crate::mesh::adjacency::Undo>,
-        around: &[u32],
-    ) -> i64 {
+    fn settle(&mut self, delta: i64, undo: Option<crate::mesh::edit::Undo>, around: &[u32]) -> i64 {
         if delta < 0 {
             self.st.accept(delta);
             self.reset_estimates(around);
@@ -319,7 +314,7 @@ impl Optimizer {
         (a, b): (u32, u32),
         level: u8,
         at: Option<Vec3>,
-    ) -> Option<(i64, crate::mesh::adjacency::Undo, Vec<u32>)> {
+    ) -> Option<(i64, crate::mesh::edit::Undo, Vec<u32>)> {
         let mid: Vec3 = at.unwrap_or(
             0.5 * (self.st.adj.positions[a as usize] + self.st.adj.positions[b as usize]),
         );

@@ -27,7 +27,7 @@ use glam::{Vec2, Vec3};
 
 use crate::error::Result;
 use crate::mesh::Mesh;
-use crate::mesh::adjacency::Adjacency;
+use crate::mesh::edit::Adjacency;
 use crate::simplify::qem;
 
 /// No node: the triangle is original (as creator) or in the coarsest mesh (as remover).

@@ -186,7 +186,7 @@ pub fn simplify_for_camera(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::mesh::adjacency::Adjacency;
+    use crate::mesh::edit::Adjacency;
     use crate::mesh::{LoadOptions, shapes};
     use glam::{Vec2, Vec3};
     use rand_core::{Rng, SeedableRng};
