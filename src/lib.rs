@@ -33,6 +33,8 @@ pub mod experiments;
 pub mod gpu;
 pub mod image;
 pub mod io;
+#[cfg(test)]
+mod layers;
 pub mod mesh;
 pub mod metric;
 pub(crate) mod prefetch;
