@@ -1,5 +1,5 @@
 //! `cargo bench --bench raster`: the rasterizer benchmark of `lodeval bench raster` (1M-triangle
-//! torus, 20 views, 1024², 1 and 4 samples, plus 16×16 region re-renders), printed as a table.
+//! torus, 20 views, 1024², 1 and 4 samples), printed as a table.
 //! Figures go to results/BENCHMARKS.md; the side-by-side run with llvmpipe is
 //! benches/raster_vs_llvmpipe.sh.
 

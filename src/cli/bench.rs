@@ -12,7 +12,7 @@ use super::print::{emit, emit_json};
 /// What `lodeval bench` measures.
 #[derive(Copy, Clone, Debug, PartialEq, Eq, ValueEnum)]
 pub(crate) enum BenchTarget {
-    /// The rasterizer on a large torus (1 and 4 samples), and region re-renders.
+    /// The rasterizer on a large torus (1 and 4 samples per pixel).
     Raster,
     /// FLIP, the VDP, SSIM and PSNR on REF TEST.
     Metrics,

@@ -9,10 +9,7 @@
 //! yields at most 7 × 4096 < 2^16 clipped triangles).
 //!
 //! Tiles are then rasterized independently, each owning its pixels, so no two threads write the
-//! same sample. The region re-render uses the same lists to find the triangles overlapping a
-//! rectangle without scanning every triangle.
-
-use std::collections::BTreeMap;
+//! same sample.
 
 use glam::Vec3;
 use rayon::prelude::*;
@@ -35,111 +32,24 @@ pub(crate) struct SetupChunk {
     items: Vec<u16>,
 }
 
-/// Id bit marking a set-up triangle of the overlay (triangles replaced by a region update).
-pub(crate) const OVERLAY: u32 = 1 << 31;
-
-/// All set-up triangles of a frame, binned, plus the overlay of triangles a region update replaced.
+/// All set-up triangles of a frame, binned.
 #[derive(Debug, Clone)]
 pub(crate) struct Binned {
     chunks: Vec<SetupChunk>,
     tiles_x: u32,
     n_tiles: usize,
-    /// Set-up triangles that replace stale source triangles; ids are `OVERLAY | index`.
-    overlay: SetupOut,
-    /// Per source triangle: its entries in `chunks` are stale (replaced). Empty until the first
-    /// replacement.
-    stale: Vec<bool>,
-    /// Source triangle → its current overlay entries. A BTreeMap so iteration is ordered.
-    overlay_of: BTreeMap<u32, Vec<u32>>,
 }
 
 impl Binned {
     /// The set-up triangle with id `id`.
     pub fn get(&self, id: u32) -> &SetupTri {
-        if id & OVERLAY != 0 {
-            return &self.overlay.tris[(id & !OVERLAY) as usize];
-        }
         &self.chunks[(id >> 16) as usize].tris[(id & 0xFFFF) as usize]
     }
 
     /// Where the corners of set-up triangle `id` lie on its source triangle.
     pub fn corners(&self, id: u32) -> Corners {
-        let clipped = if id & OVERLAY != 0 {
-            &self.overlay.clipped
-        } else {
-            &self.chunks[(id >> 16) as usize].clipped
-        };
+        let clipped = &self.chunks[(id >> 16) as usize].clipped;
         Corners::decode(self.get(id).corners, clipped)
-    }
-
-    fn is_stale(&self, src: u32) -> bool {
-        self.stale.get(src as usize).copied().unwrap_or(false)
-    }
-
-    /// Current set-up ids of source triangle `src` (several when clipped, none when culled).
-    pub fn ids_of(&self, src: u32) -> Vec<u32> {
-        if self.is_stale(src) {
-            return self.overlay_of.get(&src).cloned().unwrap_or_default();
-        }
-        let c = src as usize / CHUNK;
-        let Some(chunk) = self.chunks.get(c) else {
-            return Vec::new();
-        };
-        // Set-up triangles of a chunk are in source order.
-        let start = chunk.tris.partition_point(|t| t.tri < src);
-        let end = chunk.tris.partition_point(|t| t.tri <= src);
-        (start..end)
-            .map(|k| ((c as u32) << 16) | k as u32)
-            .collect()
-    }
-
-    /// Set up source triangle `src` (of `source_count`) anew with `setup`, which appends to the
-    /// overlay; its old entries become stale.
-    pub fn replace(&mut self, src: u32, source_count: usize, setup: impl FnOnce(&mut SetupOut)) {
-        if self.stale.is_empty() {
-            self.stale = vec![false; source_count];
-        }
-        self.stale[src as usize] = true;
-        let first = self.overlay.tris.len() as u32;
-        setup(&mut self.overlay);
-        let ids = (first..self.overlay.tris.len() as u32)
-            .map(|i| OVERLAY | i)
-            .collect();
-        self.overlay_of.insert(src, ids);
-    }
-
-    /// Ids of the current set-up triangles whose bounding boxes overlap `rect`, in the order a
-    /// full render processes them (source triangle, then clip order). Found through the tiles that
-    /// overlap `rect` and the overlay, never by scanning all triangles.
-    pub fn candidates(&self, rect: [i32; 4], width: u32, height: u32) -> Vec<u32> {
-        let overlaps = |t: &SetupTri| {
-            let b = t.bbox();
-            b[0] < rect[2] && rect[0] < b[2] && b[1] < rect[3] && rect[1] < b[3]
-        };
-        let (tx0, ty0) = (rect[0] as u32 / TILE, rect[1] as u32 / TILE);
-        let (tx1, ty1) = ((rect[2] as u32 - 1) / TILE, (rect[3] as u32 - 1) / TILE);
-        let mut ids: Vec<(u32, u32)> = Vec::new();
-        for ty in ty0..=ty1 {
-            for tx in tx0..=tx1 {
-                let t = (ty * self.tiles_x + tx) as usize;
-                debug_assert!(t < self.n_tiles && self.tile_rect(t, width, height)[0] >= 0);
-                ids.extend(
-                    self.tile(t)
-                        .filter(|(_, st)| overlaps(st))
-                        .map(|(id, st)| (st.tri, id)),
-                );
-            }
-        }
-        for (&src, list) in &self.overlay_of {
-            ids.extend(
-                list.iter()
-                    .filter(|&&id| overlaps(self.get(id)))
-                    .map(|&id| (src, id)),
-            );
-        }
-        ids.sort_unstable();
-        ids.dedup();
-        ids.into_iter().map(|(_, id)| id).collect()
     }
 
     /// Number of tiles.
@@ -158,17 +68,13 @@ impl Binned {
         ]
     }
 
-    /// The set-up triangles touching tile `t`, as (id, triangle), in source-triangle order,
-    /// without stale ones (the overlay is reached through [`Binned::candidates`]).
+    /// The set-up triangles touching tile `t`, as (id, triangle), in source-triangle order.
     pub fn tile(&self, t: usize) -> impl Iterator<Item = (u32, &SetupTri)> {
-        let stale = &self.stale;
-        let none_stale = stale.is_empty();
         self.chunks.iter().enumerate().flat_map(move |(c, chunk)| {
             let range = chunk.tile_start[t] as usize..chunk.tile_start[t + 1] as usize;
             chunk.items[range]
                 .iter()
                 .map(move |&k| (((c as u32) << 16) | k as u32, &chunk.tris[k as usize]))
-                .filter(move |(_, st)| none_stale || !stale[st.tri as usize])
         })
     }
 }
@@ -242,8 +148,5 @@ pub(crate) fn setup_and_bin(
         chunks,
         tiles_x,
         n_tiles,
-        overlay: SetupOut::default(),
-        stale: Vec::new(),
-        overlay_of: BTreeMap::new(),
     }
 }

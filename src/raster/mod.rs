@@ -29,7 +29,6 @@ pub mod incremental;
 
 mod prepare;
 mod recycle;
-mod region;
 mod resolve;
 mod scene;
 mod setup;
@@ -44,7 +43,6 @@ use crate::scene::{Camera, Projection};
 
 pub use frame::{Frame, NO_TRIANGLE, contact_sheet};
 pub use prepare::PreparedMesh;
-pub use region::RegionRenderer;
 pub use scene::RenderScene;
 #[cfg(feature = "gpu")]
 pub(crate) use shade::ResolvedLight;

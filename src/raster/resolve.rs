@@ -1,10 +1,10 @@
 //! One render pass: runs set-up and binning, rasterizes every tile in parallel, and resolves each
 //! tile's samples into pixels (shading once per distinct triangle per pixel, averaging in linear
-//! light). The region re-render (`region.rs`) keeps a pass alive and reuses its pieces.
+//! light).
 
 use std::borrow::Cow;
 
-use glam::{Mat4, Vec3};
+use glam::Vec3;
 use rayon::prelude::*;
 
 use super::RenderScene;
@@ -13,7 +13,7 @@ use super::clip::ClipPlanes;
 use super::edge::{self, EMPTY, TileSamples};
 use super::frame::{Frame, NO_TRIANGLE};
 use super::recycle;
-use super::setup::{self, Viewport, XfVertex};
+use super::setup::{self, Viewport};
 use super::shade::{ResolvedLight, ShadeContext};
 use super::{RenderSettings, Shading, camera_setup, vertex_lighting};
 use crate::scene::Camera;
@@ -23,10 +23,6 @@ use crate::scene::Camera;
 pub(crate) struct Pass {
     pub scene: RenderScene,
     pub settings: RenderSettings,
-    pub mvp: Mat4,
-    pub vp: Viewport,
-    pub planes: ClipPlanes,
-    pub xf: Vec<XfVertex>,
     pub binned: Binned,
     pub offsets: Vec<[i64; 2]>,
     count_coverage: bool,
@@ -76,16 +72,6 @@ impl<'a> RowMut<'a> {
                 triangle,
             })
     }
-
-    /// Pixels `a..b` of the run.
-    fn range(self, a: usize, b: usize) -> RowMut<'a> {
-        RowMut {
-            color: &mut self.color[a..b],
-            depth: &mut self.depth[a..b],
-            coverage: &mut self.coverage[a..b],
-            triangle: &mut self.triangle[a..b],
-        }
-    }
 }
 
 impl<'a> RectMut<'a> {
@@ -108,18 +94,6 @@ impl<'a> RectMut<'a> {
             (self.row, self.col) = (self.row + 1, 0);
         }
     }
-}
-
-/// The pixel rectangle `[x0, y0, x1, y1)` of `frame` as a resolve target.
-pub(crate) fn frame_rect(frame: &mut Frame, [x0, y0, x1, y1]: [i32; 4]) -> RectMut<'_> {
-    let w = frame.width as usize;
-    let rows = RowMut::all(frame)
-        .split(w)
-        .skip(y0 as usize)
-        .take((y1 - y0) as usize)
-        .map(|row| row.range(x0 as usize, x1 as usize))
-        .collect();
-    RectMut::new(rows)
 }
 
 /// `frame` cut into the resolve targets of its `tile`×`tile` tiles, row-major tile order.
@@ -170,10 +144,6 @@ impl Pass {
         Pass {
             scene: scene.clone(),
             settings: *settings,
-            mvp,
-            vp,
-            planes,
-            xf,
             binned,
             offsets,
             count_coverage,

@@ -26,7 +26,7 @@ pub struct RasterBench {
     /// Also write the scene (mesh and per-view matrices) here, for rendering the identical scene
     /// with another renderer (`benches/llvmpipe_raster.py`).
     pub export: Option<PathBuf>,
-    /// Where the frames are rendered (the region re-render is CPU-only and is timed on the CPU).
+    /// Where the frames are rendered.
     pub backend: crate::backend::Backend,
 }
 
@@ -49,9 +49,6 @@ pub struct RasterBenchRow {
     pub frames_per_s: f64,
     /// Millions of triangles per second.
     pub mtri_per_s: f64,
-    /// Mean microseconds to re-render one 16×16-pixel rectangle of a kept frame
-    /// ([`raster::RegionRenderer::render_rect`]), over 256 rectangles across the object.
-    pub region_16_us: f64,
     /// The renderer timed (`cpu` or `gpu: ADAPTER …`).
     pub backend: String,
 }
@@ -95,18 +92,7 @@ pub fn bench_raster(b: &RasterBench) -> Result<Vec<RasterBenchRow>> {
             std::hint::black_box(timed.render(c, &settings)?);
         }
         let secs = start.elapsed().as_secs_f64() / cameras.len() as f64;
-        // Region re-render: 16×16 rectangles on a 16×16 grid over the middle of the image.
-        let mut region = raster::RegionRenderer::new(&scene, &cameras[0], &settings)?;
-        let step = (b.size / 2 / 16).max(1) as i32;
-        let origin = (b.size / 4) as i32;
-        let start = std::time::Instant::now();
-        for i in 0..256 {
-            let (x, y) = (origin + (i % 16) * step, origin + (i / 16) * step);
-            region.render_rect([x, y, x + 16, y + 16]);
-        }
-        let region_16_us = start.elapsed().as_secs_f64() / 256.0 * 1e6;
         rows.push(RasterBenchRow {
-            region_16_us,
             triangles: mesh.triangle_count(),
             size: b.size,
             samples: n * n,
@@ -124,11 +110,11 @@ pub fn bench_raster(b: &RasterBench) -> Result<Vec<RasterBenchRow>> {
 /// The rows of `lodeval bench raster` as a Markdown table.
 pub fn raster_bench_table(rows: &[RasterBenchRow]) -> String {
     let mut text = String::from(
-        "| triangles | size | samples | views | threads | ms/frame | frames/s | Mtri/s | 16×16 region µs (CPU) | backend |\n|---|---|---|---|---|---|---|---|---|---|\n",
+        "| triangles | size | samples | views | threads | ms/frame | frames/s | Mtri/s | backend |\n|---|---|---|---|---|---|---|---|---|\n",
     );
     for r in rows {
         text.push_str(&format!(
-            "| {} | {} | {} | {} | {} | {:.1} | {:.2} | {:.1} | {:.0} | {} |\n",
+            "| {} | {} | {} | {} | {} | {:.1} | {:.2} | {:.1} | {} |\n",
             r.triangles,
             r.size,
             r.samples,
@@ -137,7 +123,6 @@ pub fn raster_bench_table(rows: &[RasterBenchRow]) -> String {
             r.ms_per_frame,
             r.frames_per_s,
             r.mtri_per_s,
-            r.region_16_us,
             r.backend
         ));
     }
