@@ -1,7 +1,6 @@
 //! Building the editable mesh from a `Mesh` (welded positions, wedges, incidence lists, vertex
 //! classes; optionally in spatial order) and turning it back into one.
 
-#[allow(unused_imports)]
 use super::*;
 
 /// Mesh vertex `v` as the wedge of welded vertex `vertex`.

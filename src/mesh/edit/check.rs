@@ -1,7 +1,6 @@
 //! The structure's invariants, checked (`Adjacency::check`, used by the property tests) and
 //! counted (border and non-manifold edges).
 
-#[allow(unused_imports)]
 use super::*;
 
 impl Adjacency {

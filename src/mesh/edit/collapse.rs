@@ -1,7 +1,6 @@
 //! Edge collapse: the legality checks (link condition, border rule, fold-over, seam partners)
 //! and the collapse itself, undoable or for good.
 
-#[allow(unused_imports)]
 use super::*;
 
 impl Adjacency {

@@ -1,7 +1,6 @@
 //! Edge split (a new vertex at the edge's midpoint) and edge swap (the diagonal of two
 //! triangles turned), both undoable.
 
-#[allow(unused_imports)]
 use super::*;
 
 impl Adjacency {

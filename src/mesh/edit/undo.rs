@@ -1,7 +1,6 @@
 //! Undo: the triangles and vertices an operation will touch are snapshotted before it changes
 //! anything, and restoring the snapshots gives back the exact previous state.
 
-#[allow(unused_imports)]
 use super::*;
 
 impl Adjacency {

@@ -1,7 +1,6 @@
 //! Making a trial the committed state: the changed region rendered again with its three layers,
 //! the per-triangle shown counts and per-tile far depths; and `revert`.
 
-#[allow(unused_imports)]
 use super::*;
 
 impl View {

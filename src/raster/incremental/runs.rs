@@ -1,7 +1,6 @@
 //! Shading the pixels a trial touches: the re-shaded runs, the per-piece plane cache, and the
 //! Gouraud luminance of a piece at a pixel.
 
-#[allow(unused_imports)]
 use super::*;
 
 /// What the shading of a touched pixel whose plane is not cached reads and fills in: the

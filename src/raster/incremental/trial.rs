@@ -1,7 +1,6 @@
 //! A view's trial: the changed triangles set up anew, the holes they leave filled from the
 //! layers behind them, their new pieces depth-tested, and ΔE over the pixels that can change.
 
-#[allow(unused_imports)]
 use super::*;
 
 impl View {

@@ -1,7 +1,6 @@
 //! [`LumaViews`]: the luminance images of all views, and the trial, commit and revert the
 //! optimizer calls, spread over the crew (see the parent module).
 
-#[allow(unused_imports)]
 use super::*;
 
 impl LumaViews {
