@@ -3,6 +3,7 @@
 //! image writers here are the only place where linear colour becomes sRGB bytes on disk.
 
 pub mod csv;
+pub mod label;
 pub mod plot;
 
 use std::io::Write;

@@ -1,26 +1,27 @@
 //! lodeval: does a simplified mesh (a level of detail) still look like the original, and from how
 //! far away can nobody tell them apart?
 //!
-//! Data flow (DESIGN.md):
+//! The crate is built in layers, each using only the layers below it (the README's Architecture
+//! section has the table; `src/layers.rs` tests it):
 //!
 //! ```text
-//! configs/*.toml ─► eval::Plan  (assets × LODs × views × lights, metrics, viewing, gates)
-//!                      │
-//!  mesh::load ─────────┤  OBJ+MTL · PLY · glTF 2.0 · OFF — validated, textures decoded once
-//!                      ▼
-//!  raster::render(&Scene, &Camera, &RenderSettings) ─► Frame (linear RGB f32, depth, coverage, id)
-//!                      ▼
-//!  metric::{mse, ssim, flip, vdp, ...}(&reference, &test, &Viewing) ─► Score {value, map}
-//!                      ▼
-//!  eval::Row ─► metrics.csv · summary.csv · distances.csv · heatmaps · junit.xml · report.html
-//!                      ▼
-//!  eval::gate ─► exit code
+//! error · color · image · io      shared ground: errors, colour encodings, linear images, files
+//!   mesh                           loaders (OBJ+MTL, PLY, glTF 2.0, OFF), validation, normals
+//!   scene                          what is lit and seen: materials, lights, cameras, rigs
+//!   raster · metric                the CPU rasterizer; the perceptual difference stack
+//!   gpu · backend                  the wgpu mirror of the rasterizer; the choice between the two
+//!   simplify                       QEM engine, Williams et al. 2003, Lindstrom & Turk
+//!   eval                           plans, image pairs, scores, distances, gates, reports
+//!   experiments · app              the papers' reproductions; one job per CLI command
 //! ```
 //!
-//! Built so far: [`mesh`] (loading, validation, normals, welding, bounds) and the colour
-//! encodings in [`metric::color`]. The other stages arrive with their issues.
+//! One image pair from config to CSV row: [`eval::Plan`] names assets × LODs × views × lights;
+//! [`mesh::load`] reads each mesh once; [`raster::render`] turns a [`raster::RenderScene`] and a
+//! [`scene::Camera`] into a [`raster::Frame`] (linear RGB, depth, coverage); [`metric`] scores the
+//! pair (MSE/PSNR, SSIM, FLIP, the VDP) in [`image::LinearImage`]s built from the frames; `eval`
+//! writes `metrics.csv`, `summary.csv`, `distances.csv`, heat maps, plots and `report.html`, and its
+//! gate decides the exit code. Colour conversions live in [`color`].
 
-#![warn(missing_docs, missing_debug_implementations)]
 
 pub mod app;
 pub mod backend;

@@ -13,7 +13,7 @@
 //! instead. Borders follow scikit-image, the oracle (`reference/oracles/`): Gaussian filtering
 //! with mirrored borders (scipy's "reflect"), and the mean taken over the image minus a 5-pixel
 //! border, so that only windows fully inside the image count. The local moments are filtered in
-//! `f32` on values centred at 0.5 (no cancellation in E[x²] − E[x]²; the oracle pairs agree to
+//! `f32` on values centred at 0.5 (no cancellation in E\[x²\] − E\[x\]²; the oracle pairs agree to
 //! < 5e-7) and combined in `f64`; bands of rows run in parallel and sums are combined in row order.
 
 use rayon::prelude::*;
@@ -124,7 +124,7 @@ fn terms(a: &Plane, b: &Plane, want_map: bool) -> (Vec<f32>, Vec<[f64; 3]>) {
                     for (p, &col) in padded.chunks_exact_mut(5).zip(&columns) {
                         let idx = y * w + col;
                         // Centred on the middle of the range: the moments are accumulated in f32 (twice
-                        // the SIMD width of f64), and centring keeps E[x²] − E[x]² free of cancellation.
+                        // the SIMD width of f64), and centring keeps E\[x²\] − E\[x\]² free of cancellation.
                         let (x, yv) = (a.v[idx] - 0.5, b.v[idx] - 0.5);
                         p.copy_from_slice(&[x, yv, x * x, yv * yv, x * yv]);
                     }

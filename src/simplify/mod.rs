@@ -159,7 +159,7 @@ pub(crate) fn flatten(lod: &Mesh) -> Result<Mesh> {
 /// original each time.
 ///
 /// Meshes split only by normals are simplified welded, and flat-shaded originals get flat LODs
-/// (see [`normal_only_seams`]).
+/// (see `normal_only_seams`).
 pub fn chain(mesh: &Mesh, method: Method, goals: &[Goal]) -> Result<Vec<Lod>> {
     if let Some((welded, flat)) = normal_only_seams(mesh) {
         let lods = chain_of(&welded, method, goals)?;

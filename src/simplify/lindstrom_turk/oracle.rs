@@ -3,7 +3,7 @@
 //! For each view, the absolute luminance difference |ŷ − y| is blurred (a separable box filter
 //! of radius [`BLUR_RADIUS`] applied twice, close to a Gaussian of σ ≈ 2.8 px), and an edge's
 //! potential is the sum, over views, of the blurred difference at the projections of its two
-//! endpoints (the paper projects the vertices "onto the screen and [sums] up the pixel
+//! endpoints (the paper projects the vertices "onto the screen and \[sums\] up the pixel
 //! differences from blurred versions of the difference images"). Occlusion is ignored, as in the
 //! paper: the oracle only ranks candidates.
 
