@@ -5,6 +5,7 @@
 pub mod csv;
 pub mod label;
 pub mod plot;
+pub mod plot_png;
 
 use std::io::Write;
 use std::path::Path;

@@ -22,7 +22,6 @@
 //! writes `metrics.csv`, `summary.csv`, `distances.csv`, heat maps, plots and `report.html`, and its
 //! gate decides the exit code. Colour conversions live in [`color`].
 
-
 pub mod app;
 pub mod backend;
 pub mod color;

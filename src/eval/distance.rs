@@ -92,7 +92,7 @@ impl Screen {
 }
 
 /// Smallest on-screen diameter probed, pixels.
-const MIN_PROBE: u32 = 4;
+pub(super) const MIN_PROBE: u32 = 4;
 
 /// What a search needs about one LOD.
 #[derive(Debug)]

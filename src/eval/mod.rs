@@ -9,6 +9,7 @@
 //! - `tables.rs` — `metrics.csv`, `summary.csv`, `distances.csv`, `lods.csv`;
 //! - `gate.rs` — thresholds, switch distances, baseline comparison;
 //! - `junit.rs`, `report.rs` — `junit.xml`, `report.html`;
+//! - `plots.rs` — `plots/*.png` (error against triangles, switch distances);
 //! - `golden.rs` — golden-image compare and bless.
 //!
 //! This file joins them: [`eval`] runs a config (or one shard of it) and writes every output,
@@ -22,6 +23,7 @@ pub mod gate;
 pub mod golden;
 pub mod junit;
 pub mod plan;
+pub mod plots;
 pub mod report;
 pub mod run;
 pub mod score;
@@ -98,6 +100,7 @@ fn finish(plan: Plan, out_dir: PathBuf, results: Results, manifest: &Manifest) -
         &out_dir.join("report.html"),
         report::render(&plan, &results, &failures).as_bytes(),
     )?;
+    plots::write(&plan, &results, &out_dir)?;
     let json = serde_json::to_string_pretty(manifest)
         .map_err(|e| Error::Internal(format!("shard.json: {e}")))?;
     crate::io::write_atomic(&out_dir.join("shard.json"), json.as_bytes())?;

@@ -13,6 +13,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::error::{Error, Result};
 use crate::io::plot::{Series, line_plot as plot};
+use crate::io::plot_png::Chart;
 use crate::mesh::{self, LoadOptions, Mesh};
 use crate::simplify::lindstrom_turk::{
     Options, Targets, cameras, d_ms, held_out_rig, optimize_towards, target_images,
@@ -214,28 +215,33 @@ pub fn run(config: &Path, log: &mut dyn FnMut(&str)) -> Result<Vec<ResultRow>> {
                 false,
             ));
         }
-        let svg = plot(
+        write_figure(
+            &out.join(format!("{}-energy-vs-vertices", spec.name)),
             &format!("{}: held-out d_MS against vertex count", spec.name),
             "vertices",
             "held-out d_MS",
             &series,
-            false,
-        );
-        crate::io::write_atomic(
-            &out.join(format!("{}-energy-vs-vertices.svg", spec.name)),
-            svg.as_bytes(),
         )?;
     }
     let series: Vec<Series> = curves.into_iter().map(|(n, p)| (n, p, false)).collect();
-    let svg = plot(
+    write_figure(
+        &out.join("energy-vs-evals"),
         "energy (relative to the input) against evaluations",
         "energy evaluations",
         "E / E(input)",
         &series,
-        false,
-    );
-    crate::io::write_atomic(&out.join("energy-vs-evals.svg"), svg.as_bytes())?;
+    )?;
     Ok(rows)
+}
+
+/// One figure as `STEM.svg` and `STEM.png` (linear axes).
+fn write_figure(stem: &Path, title: &str, x: &str, y: &str, series: &[Series]) -> Result<()> {
+    let svg = plot(title, x, y, series, false);
+    crate::io::write_atomic(&stem.with_extension("svg"), svg.as_bytes())?;
+    crate::io::plot_png::write(
+        &stem.with_extension("png"),
+        &Chart::from_series(title, x, y, series, false),
+    )
 }
 
 #[cfg(test)]

@@ -27,6 +27,7 @@ use crate::eval::config::MetricFamily;
 use crate::eval::score::{Reference, Scorer};
 use crate::image::LinearImage;
 use crate::io::plot::{Series, line_plot};
+use crate::io::plot_png::Chart;
 use crate::mesh::{self, LoadOptions, Mesh};
 use crate::raster::{self, Frame, RenderScene, RenderSettings, SamplePattern, Shading};
 use crate::scene::{Camera, Rig, Viewing};
@@ -381,10 +382,11 @@ pub fn run(config: &Path, log: &mut dyn FnMut(&str)) -> Result<Vec<SummaryRow>> 
     Ok(summary)
 }
 
-/// `SCENE.svg`: four panels stacked — view-0 FLIP, view-0 VDP JND, mean FLIP, mean VDP JND —
+/// `SCENE.svg` and `SCENE.png`: four panels stacked — view-0 FLIP, view-0 VDP JND, mean FLIP, mean VDP JND —
 /// against the budget in triangles, one line per criterion.
 fn write_plots(out: &Path, scene: &str, summary: &[SummaryRow]) -> Result<()> {
     let mut panels = Vec::new();
+    let mut charts = Vec::new();
     type Pick = fn(&SummaryRow) -> f64;
     let picks: [(&str, &str, Pick); 4] = [
         ("view 0: FLIP", "FLIP mean", |r| r.view0_flip),
@@ -404,14 +406,15 @@ fn write_plots(out: &Path, scene: &str, summary: &[SummaryRow]) -> Result<()> {
                 series.push((c.name().to_string(), pts, false));
             }
         }
-        panels.push(line_plot(
-            &format!("{scene} — {title}"),
-            "triangle budget (log scale)",
-            y,
-            &series,
-            true,
-        ));
+        let title = format!("{scene} — {title}");
+        let x = "triangle budget (log scale)";
+        panels.push(line_plot(&title, x, y, &series, true));
+        charts.push(Chart::from_series(&title, x, y, &series, true));
     }
+    crate::io::write_atomic(
+        &out.join(format!("{scene}.png")),
+        &crate::io::plot_png::encode_stack(&charts)?,
+    )?;
     // Stack the panels vertically in one SVG.
     let mut svg =
         String::from("<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"720\" height=\"1680\">");

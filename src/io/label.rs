@@ -199,7 +199,10 @@ mod tests {
         );
         assert!((10..=12).contains(&x_min), "starts at {x_min}");
         let width = text_width("view 07", 14.0);
-        assert!((x_max as f32 - 10.0 - width).abs() < 3.0, "{x_max} vs {width}");
+        assert!(
+            (x_max as f32 - 10.0 - width).abs() < 3.0,
+            "{x_max} vs {width}"
+        );
         // Cap height of a 14 px font is about 10 px, all above the baseline (no descenders here).
         assert!(y_min >= 13 && y_max <= 25, "rows {y_min}..{y_max}");
     }
@@ -208,7 +211,13 @@ mod tests {
     fn alignment_moves_the_run_by_its_width() {
         let draw = |align| {
             let mut img = image::RgbImage::from_pixel(300, 30, image::Rgb([255; 3]));
-            draw_rgb(&mut img, "0.25", 150.0, 20.0, Style::new(12.0, [0; 3]).align(align));
+            draw_rgb(
+                &mut img,
+                "0.25",
+                150.0,
+                20.0,
+                Style::new(12.0, [0; 3]).align(align),
+            );
             ink(&img).iter().map(|p| p.0).min().unwrap() as f32
         };
         let w = text_width("0.25", 12.0);
@@ -221,7 +230,13 @@ mod tests {
         let mut flat = image::RgbImage::from_pixel(120, 120, image::Rgb([255; 3]));
         let mut turned = flat.clone();
         draw_rgb(&mut flat, "FLIP", 20.0, 60.0, Style::new(16.0, [0; 3]));
-        draw_rgb(&mut turned, "FLIP", 60.0, 100.0, Style::new(16.0, [0; 3]).vertical());
+        draw_rgb(
+            &mut turned,
+            "FLIP",
+            60.0,
+            100.0,
+            Style::new(16.0, [0; 3]).vertical(),
+        );
         let mut a: Vec<(i32, i32)> = ink(&flat)
             .iter()
             .map(|&(x, y)| (x as i32 - 20, y as i32 - 60))
@@ -252,8 +267,13 @@ mod tests {
 
     #[test]
     fn every_symbol_labels_use_is_in_the_subset() {
-        for c in "0123456789.,:;-+×−–—≤≥≈·°²µ%()[]/ abcxyzABCXYZ αβγδεσωΔ→".chars() {
-            assert_ne!(font().glyph_id(c).0, 0, "{c:?} is missing from the font subset");
+        for c in "0123456789.,:;-+×−–—≤≥≈·°²µ%()[]/ abcxyzABCXYZ αβγδεσωΔ→".chars()
+        {
+            assert_ne!(
+                font().glyph_id(c).0,
+                0,
+                "{c:?} is missing from the font subset"
+            );
         }
     }
 }

@@ -8,7 +8,7 @@ use std::fmt::Write as _;
 /// A plotted series: name, points, dashed.
 pub type Series = (String, Vec<(f64, f64)>, bool);
 
-const COLORS: [&str; 8] = [
+pub(crate) const COLORS: [&str; 8] = [
     "#1b9e77", "#d95f02", "#7570b3", "#e7298a", "#66a61e", "#e6ab02", "#a6761d", "#666666",
 ];
 
