@@ -1,4 +1,4 @@
-//! The one library error type and its mapping to the exit codes of DESIGN.md.
+//! The one library error type and its mapping to the exit codes listed in the README.
 //!
 //! Errors are split by who is at fault (the lyon habit): [`Error::Input`] is the user's file or
 //! config, [`Error::Usage`] is the command line, [`Error::Internal`] is ours ("please file an
@@ -82,7 +82,7 @@ impl Error {
         }
     }
 
-    /// The process exit code DESIGN.md assigns to this error:
+    /// The process exit code the README assigns to this error:
     /// 1 regression/mismatch, 2 bad input or usage, 3 internal error.
     pub fn exit_code(&self) -> u8 {
         match self {

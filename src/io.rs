@@ -1,5 +1,5 @@
 //! Output files: written to a temporary file in the destination folder and renamed into place,
-//! so a crash or a bad input never leaves a half-written output (DESIGN.md, "Errors"). The 8-bit
+//! so a crash or a bad input never leaves a half-written output (README, Architecture, "Errors"). The 8-bit
 //! image writers here are the only place where linear colour becomes sRGB bytes on disk.
 
 pub mod csv;

@@ -1,5 +1,5 @@
 //! The batch configuration: a TOML file parsed with serde (`deny_unknown_fields` everywhere), its
-//! defaults (DESIGN.md, documented key by key in `configs/README.md`), and the checks that turn a
+//! defaults (documented key by key in `configs/README.md`), and the checks that turn a
 //! bad key or value into one exit-2 message naming the key, the file and the line.
 //!
 //! Decisions:
@@ -145,7 +145,7 @@ impl RenderConfig {
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields, tag = "kind", rename_all = "lowercase")]
 pub enum LightConfig {
-    /// The camera-following light (DESIGN.md default).
+    /// The camera-following light (the default).
     Headlight {
         /// Grey intensity. Default value: 0.85.
         intensity: Option<UnitInterval>,

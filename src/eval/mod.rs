@@ -1,4 +1,4 @@
-//! Batch evaluation: configs → plan → renders and scores → the output files of DESIGN.md → the
+//! Batch evaluation: configs → plan → renders and scores → the output files the README lists → the
 //! gate's exit code. One stage per file:
 //!
 //! - `config.rs` — the TOML schema, defaults, and exit-2 messages with file and line;

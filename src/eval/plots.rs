@@ -19,9 +19,16 @@ use super::tables::Results;
 use crate::error::Result;
 use crate::io::plot_png::{self, Chart, Line, Mark};
 
-/// The metrics plotted, with their titles and the gate limits that bound them (limit name, the
-/// statistic it bounds).
-const METRICS: [(&str, &str, &[(&str, &str)]); 5] = [
+/// A plotted metric: its column, its axis title, and the gate limits that bound it (limit name,
+/// the statistic it bounds).
+type PlottedMetric = (
+    &'static str,
+    &'static str,
+    &'static [(&'static str, &'static str)],
+);
+
+/// The metrics plotted.
+const METRICS: [PlottedMetric; 5] = [
     (
         "flip",
         "FLIP (0 = identical)",

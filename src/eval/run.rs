@@ -12,7 +12,8 @@
 //! - Every LOD is rendered with the original's cameras (framed on the original's bounding sphere),
 //!   as an engine would draw it in the original's place.
 //! - Contact sheets show original | LOD | FLIP heat map (VDP where FLIP is off; SSIM last), the
-//!   LOD's worst views first, as 256-pixel thumbnails.
+//!   LOD's worst views first, as 256-pixel thumbnails, each captioned inside the PNG (the view
+//!   number and which image it is; the heat map's metric and that view's score).
 
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -152,12 +153,23 @@ pub fn run(plan: Plan, options: &RunOptions, progress: &dyn Progress) -> Result<
                             write_heat_map(&out_dir, &asset.name, &lod.name, v, metric, map)?;
                         }
                     }
-                    let thumbs = scored.maps.first().map(|(_, map)| {
+                    let thumbs = scored.maps.first().map(|(metric, map)| {
                         let heat = colormap::heat_map(&map.values, map.width, map.height, 0);
+                        let score = scored
+                            .values
+                            .iter()
+                            .find(|(m, _)| m == metric)
+                            .map_or(String::new(), |(_, x)| format!(" {x:.4}"));
                         [
-                            ref_thumb.clone(),
-                            thumbnail(&test_frame.to_srgb8()),
-                            thumbnail(&heat),
+                            captioned(ref_thumb.clone(), &format!("view {v} · original")),
+                            captioned(
+                                thumbnail(&test_frame.to_srgb8()),
+                                &format!("view {v} · {}", lod.name),
+                            ),
+                            captioned(
+                                thumbnail(&heat),
+                                &format!("{}{score}", metric.to_uppercase()),
+                            ),
                         ]
                     });
                     bar.advance(1);
@@ -390,6 +402,12 @@ fn write_heat_map(
         &heat_map_path(out, asset, lod, view, metric),
         &image::DynamicImage::ImageRgb8(img),
     )
+}
+
+/// A contact-sheet tile with its caption across the top.
+fn captioned(mut tile: image::RgbImage, text: &str) -> image::RgbImage {
+    crate::io::label::caption_rgb(&mut tile, text, 12.0);
+    tile
 }
 
 fn thumbnail(img: &image::RgbImage) -> image::RgbImage {

@@ -1,4 +1,4 @@
-//! The rows a run produces and the CSV files of DESIGN.md that hold them: `metrics.csv`,
+//! The rows a run produces and the CSV files that hold them (columns in the README): `metrics.csv`,
 //! `summary.csv`, `distances.csv` (schemas fixed; columns are only ever added at the end), plus
 //! `lods.csv`, the per-LOD facts a merge needs.
 //!
@@ -353,7 +353,7 @@ pub fn percentile(values: &[f64], p: f64) -> f64 {
     s[lo] + (s[hi] - s[lo]) * (rank - lo as f64)
 }
 
-/// A table row type and its CSV header (DESIGN.md's schema; the serde field order must match).
+/// A table row type and its CSV header (the README's schema; the serde field order must match).
 pub trait Columns {
     /// Column names in order.
     const COLUMNS: &'static [&'static str];

@@ -172,6 +172,20 @@ pub fn draw_rgb(img: &mut image::RgbImage, text: &str, x: f32, y: f32, style: St
     });
 }
 
+/// Writes `text` in white across the top of `img` on a darkened band (a contact-sheet tile's
+/// caption), at `px` pixels; a caption wider than the image is cut at its edge.
+pub fn caption_rgb(img: &mut image::RgbImage, text: &str, px: f32) {
+    let band = (px * 1.45).ceil() as u32;
+    for y in 0..band.min(img.height()) {
+        for x in 0..img.width() {
+            let p = img.get_pixel_mut(x, y);
+            p.0 = p.0.map(|c| (c as f32 * 0.3).round() as u8);
+        }
+    }
+    let baseline = ((band as f32 + ascent(px) * 0.75) / 2.0).round();
+    draw_rgb(img, text, 4.0, baseline, Style::new(px, [255, 255, 255]));
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -11,7 +11,7 @@
 //!
 //! # Guarantees
 //! - Each list is sorted ascending and holds no duplicates, as long as callers only insert ids
-//!   the list does not hold (every caller in `adjacency.rs` does).
+//!   the list does not hold (every caller in `mesh/edit/` does).
 //! - Equality ([`PartialEq`]) compares the lists, not where they sit in the arena.
 
 /// Room given to each list beyond its length when the lists are built, so that the first

@@ -1,7 +1,7 @@
 //! Decoded texture images and the shared texture cache used by the loaders.
 //!
 //! A texture is decoded once and shared by `Arc` between every material that names the same file
-//! (DESIGN.md: "textures decoded once, Arc-shared"). Pixels stay 8-bit RGBA with their colour space
+//! (the architecture contract in the README: "textures decoded once and shared"). Pixels stay 8-bit RGBA with their colour space
 //! tagged; linearisation belongs to the renderer's mip-pyramid build (`raster/texture.rs`).
 //!
 //! Decision: texture file names from MTL files are resolved relative to the MTL file, with

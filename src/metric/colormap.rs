@@ -4,7 +4,9 @@
 //! colour map, 2015; CC0) — the 256 entries below are matplotlib's `_magma_data`, which FLIP's
 //! reference implementation also uses for its error maps. Entries are sRGB-encoded values in 0..1.
 //!
-//! Decision: the map index is round(255·v) for v clamped to [0, 1], as FLIP's tool does.
+//! Decision: the map index is round(255·v) for v clamped to [0, 1], as FLIP's tool does. A legend
+//! strip of 12 pixels or more (a heat map of 384² or larger) carries the numbers 0 … 1 in the
+//! bundled font (`io::label`).
 
 /// Map a value in [0, 1] to an 8-bit sRGB colour of the magma map.
 pub fn magma(v: f32) -> [u8; 3] {
@@ -29,7 +31,33 @@ pub fn heat_map(values: &[f32], width: usize, height: usize, legend: usize) -> i
             img.put_pixel(x as u32, y as u32, image::Rgb(magma(v)));
         }
     }
+    if legend >= MIN_LABELLED_LEGEND && width >= 120 {
+        label_legend(&mut img, height as f32, legend as f32);
+    }
     img
+}
+
+/// The smallest legend strip (pixels high) that gets numbers.
+const MIN_LABELLED_LEGEND: usize = 12;
+
+/// Numbers 0, 0.25, 0.5, 0.75 and 1 inside the legend strip at their places, white on the dark
+/// end of the map and black on the light end.
+fn label_legend(img: &mut image::RgbImage, top: f32, legend: f32) {
+    use crate::io::label::{self, Align, Style};
+    let px = (legend * 0.75).clamp(9.0, 14.0);
+    let baseline = (top + (legend + label::ascent(px) * 0.75) / 2.0).round();
+    let width = img.width() as f32;
+    for (v, text, align) in [
+        (0.0, "0", Align::Left),
+        (0.25, "0.25", Align::Center),
+        (0.5, "0.5", Align::Center),
+        (0.75, "0.75", Align::Center),
+        (1.0, "1", Align::Right),
+    ] {
+        let x = (v * (width - 1.0)).clamp(3.0, width - 4.0);
+        let ink = if v < 0.6 { [255, 255, 255] } else { [0, 0, 0] };
+        label::draw_rgb(img, text, x, baseline, Style::new(px, ink).align(align));
+    }
 }
 
 #[rustfmt::skip]

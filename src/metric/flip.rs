@@ -14,7 +14,7 @@
 //! clamped, the spatial filter radius is ⌈3·√(max b / 2π²)·ppd⌉, the feature filter's Gaussian sums
 //! to 1 and the positive and negative lobes of its derivatives to ±1, arithmetic is `f32`.
 //!
-//! Prepare once, compare many (DESIGN.md): [`Flip::prepare`] does each image's filtering; the
+//! Prepare once, compare many (README, Architecture): [`Flip::prepare`] does each image's filtering; the
 //! comparison is per pixel. Rows run in parallel; every pixel's arithmetic is independent of the
 //! schedule, and the mean is a fixed-order sum of per-row `f64` sums, so results do not depend on
 //! the thread count.
@@ -201,7 +201,7 @@ pub struct FlipScore {
 }
 
 impl Flip {
-    /// FLIP for `ppd` pixels per degree of visual angle (DESIGN.md default: 67.02).
+    /// FLIP for `ppd` pixels per degree of visual angle (default: 67.02, the README's office display).
     pub fn new(ppd: f32) -> Flip {
         Flip {
             ppd,

@@ -4,7 +4,7 @@
 //! as glam's `camera::rh::proj::directx` (the DirectX/WebGPU convention wgpu uses). Framing puts the sphere's centre on the optical
 //! axis at the distance where the sphere, grown by the margin, just fits the narrower field of view.
 //!
-//! Decision (DESIGN.md is silent): default vertical field of view 30°, margin 5 % of the radius.
+//! Decision (the architecture contract is silent): default vertical field of view 30°, margin 5 % of the radius.
 
 use glam::camera::rh::{proj::directx, view::look_at_mat4};
 use glam::{Mat4, Vec3};

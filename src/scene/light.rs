@@ -1,5 +1,5 @@
 //! Lights for the Blinn–Phong shading models: fixed directional lights and the "headlight" that
-//! follows the camera (DESIGN.md default; Lindstrom & Turk §4.1 place "a light near each viewer").
+//! follows the camera (the default; Lindstrom & Turk §4.1 place "a light near each viewer").
 //!
 //! Decision: the headlight comes from slightly above and to the left of the eye
 //! ([`HEADLIGHT_OFFSET`], camera space), so that shading is not flat and silhouettes darken; with a

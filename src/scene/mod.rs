@@ -35,7 +35,7 @@ impl Scene {
     /// Default ambient term.
     pub const DEFAULT_AMBIENT: f32 = 0.15;
 
-    /// A scene with DESIGN.md's defaults: one headlight, mid-grey background.
+    /// A scene with the defaults of the README's architecture section: one headlight, mid-grey background.
     pub fn new(mesh: Arc<Mesh>) -> Scene {
         Scene {
             mesh,

@@ -2,7 +2,7 @@
 //!
 //! Decision: pixels per degree follow FLIP's reference implementation (and its paper's
 //! definition), the small-angle form ppd = d · (N_px / W) · π/180 for a display W metres wide with
-//! N_px pixels seen from d metres. DESIGN.md's default — a 0.7 m wide, 3840-pixel display at
+//! N_px pixels seen from d metres. The default (README, Architecture, "Defaults") — a 0.7 m wide, 3840-pixel display at
 //! 0.7 m — gives 67.02 ppd.
 
 /// A display and the viewer's distance to it.
@@ -20,7 +20,7 @@ pub struct Viewing {
 }
 
 impl Viewing {
-    /// DESIGN.md's defaults.
+    /// the defaults of the README's architecture section.
     pub const DEFAULT: Viewing = Viewing {
         display_width_m: 0.7,
         display_px: 3840.0,

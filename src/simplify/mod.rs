@@ -1,5 +1,5 @@
 //! Simplifiers, one algorithm per file: the industrial baseline (meshoptimizer, `meshopt.rs`), our
-//! edge-collapse engine with Garland–Heckbert quadrics (`qem.rs`, on `mesh::adjacency`), and
+//! edge-collapse engine with Garland–Heckbert quadrics (`qem.rs`, on `mesh::edit`), and
 //! Rossignac–Borrel vertex clustering (`cluster.rs`). The paper algorithms (Williams et al.,
 //! Menzel–Guthe, Lindstrom–Turk, Qu–Meyer) join here. This file is the one entry point `eval` and
 //! the CLI use: a method, a chain of targets, LOD meshes out.

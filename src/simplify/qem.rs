@@ -27,7 +27,7 @@
 //!   planes its quadric holds (model units). Error targets are relative to the bounding-box
 //!   diagonal.
 //! - Non-manifold parts (edges with more than two triangles, common in scans) are simplified too
-//!   ([`progressive`] allows non-manifold collapses; see `mesh/adjacency.rs`): Garland and
+//!   ([`progressive`] allows non-manifold collapses; see `mesh/edit/`): Garland and
 //!   Heckbert's vertex-pair contraction needs no manifold, and with them fixed the Stanford dragon
 //!   could not go below 5 %.
 //!

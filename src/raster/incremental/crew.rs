@@ -1,5 +1,5 @@
 //! A crew of worker threads that stay awake between short parallel jobs: the image-driven
-//! optimizer's trials (`luminance.rs`) spread 20 views over the cores thousands of times a
+//! optimizer's trials (`trial.rs`) spread 20 views over the cores thousands of times a
 //! second, and each trial takes a few hundred microseconds.
 //!
 //! Why not rayon here: between two trials rayon's workers go to sleep, and each trial wakes them

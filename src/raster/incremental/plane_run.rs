@@ -1,6 +1,6 @@
 //! The squared luminance errors of a run of pixels that show one constant-albedo piece: the
 //! optimizer's re-shaded pixels (Lindstrom & Turk 2000, eq. 2's Σ (ŷ − y′)² over them), where
-//! y′ is the piece's luminance plane ratio N(x, y) / D(x, y) (see `luminance.rs`, `LumaPlane`)
+//! y′ is the piece's luminance plane ratio N(x, y) / D(x, y) (see `mod.rs`, `LumaPlane`)
 //! encoded through the 16-bit sRGB code table.
 //!
 //! Two implementations with the same result to the bit: four pixels at a time in AVX2 registers

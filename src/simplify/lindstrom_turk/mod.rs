@@ -1,9 +1,10 @@
 //! Lindstrom & Turk, Image-Driven Mesh Optimization (2001): improve a simplified mesh — vertex
 //! positions, attributes and connectivity — so its renderings match the original's, keeping its
-//! vertex count. `../shared/papers/lindstrom-turk-image-driven-mesh-optimization.md`.
+//! vertex count. Peter Lindstrom and Greg Turk, "Image-Driven Mesh Optimization", Georgia Institute
+//! of Technology (2001).
 //!
 //! One step per file:
-//! - energy: `raster::luminance` keeps the luminance images of the current mesh in l views and
+//! - energy: `raster::incremental` keeps the luminance images of the current mesh in l views and
 //!   evaluates eq. 2's ΔE over the changed rectangles (§4.2–4.3); E is eq. 1's d_MS without its
 //!   1/(lmn) factor, exact in integers;
 //! - `edit.rs`: the mesh state, trying and undoing changes, the simplex over a vertex set (§5.1);

@@ -8,7 +8,8 @@
 //!   silhouette and shading normal cones, texel luminance range, texture deviation;
 //! - `perception.rs` — per-view contrast, frequency and imperceptibility distance (§3, §5.2–5.4),
 //!   and the comparison criteria of §6;
-//! - `cut.rs` — best-effort dual-queue refinement to a budget with temporal coherence (§5.1);
+//! - `cut.rs` — best-effort dual-queue refinement to a budget with temporal coherence (§5.1).
+//!
 //! The paper's evaluation (§6, Figure 4) is `crate::experiments::williams2003`.
 //!
 //! This file ties them together: build once ([`Williams::build`]), then adapt a cut per camera
@@ -41,7 +42,7 @@ pub struct Options {
     pub shading: Shading,
     /// The error criterion. Default value: `Perceptual`.
     pub criterion: Criterion,
-    /// Viewing conditions (pixels per degree, viewing distance). Default value: DESIGN.md's.
+    /// Viewing conditions (pixels per degree, viewing distance). Default: the README's office display.
     pub viewing: Viewing,
     /// Image width and height in pixels. Default value: 512 × 512.
     pub size: (u32, u32),
