@@ -43,5 +43,10 @@ pub mod raster;
 pub mod scene;
 pub mod simplify;
 
+// What a library user reaches for first, at the crate root.
 pub use error::{Error, Location, Result};
+pub use eval::{Plan, Results, RunOptions};
+pub use image::{ErrorMap, LinearImage};
 pub use mesh::{LoadOptions, Mesh, MeshSummary, MissingAssets};
+pub use raster::{Frame, RenderScene};
+pub use scene::{Camera, Rig, Viewing};

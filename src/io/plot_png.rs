@@ -3,8 +3,8 @@
 //! switch-distance plots, and the paper experiments' figures beside their SVGs.
 //!
 //! A [`Chart`] is data only (series, point labels, reference lines); [`render`] lays it out:
-//! a title, a plot area with a light grid, a linear y axis with "nice" ticks (1, 2 or 5 × 10^k
-//! steps, from zero unless the data are negative or the chart asks for a tight range), a linear
+//! a title, a plot area with a light grid, a linear y axis with "nice" ticks (about six steps of 1,
+//! 2 or 5 × 10^k, from zero unless the data are negative or the chart asks for a tight range), a linear
 //! or logarithmic x axis (decade ticks labelled 1k, 10k, 1M, with 2× and 5× ticks when the data
 //! span less than two decades), reference lines (a gate limit across, the original's triangle
 //! count upright), and a legend on the right. Colours are the SVG plots' palette (`plot.rs`).
@@ -69,6 +69,10 @@ const LEFT: f32 = 84.0;
 const RIGHT: f32 = 200.0;
 const TOP: f32 = 62.0;
 const BOTTOM: f32 = 58.0;
+/// About how many steps a linear axis is divided into.
+const TICKS: f64 = 6.0;
+/// Series with more points than this are drawn without dots.
+const MAX_DOTS: usize = 16;
 const INK: [u8; 3] = [40, 40, 40];
 const MUTED: [u8; 3] = [100, 100, 100];
 
@@ -277,7 +281,10 @@ pub fn render(chart: &Chart) -> Pixmap {
             if sx < pclip.left() || sx > pclip.right() || sy < pclip.top() || sy > pclip.bottom() {
                 continue;
             }
-            if let Some(dot) = PathBuilder::from_circle(sx, sy, 3.5) {
+            // A dense curve's dots would hide its line.
+            if pts.len() <= MAX_DOTS
+                && let Some(dot) = PathBuilder::from_circle(sx, sy, 3.5)
+            {
                 pm.fill_path(&dot, &ink, FillRule::Winding, Transform::identity(), None);
             }
             if let Some(text) = text.filter(|t| !t.is_empty()) {
@@ -356,7 +363,7 @@ impl Axis {
     /// A linear axis over [lo, hi] widened to whole tick steps.
     fn linear(lo: f64, hi: f64) -> Axis {
         let hi = if hi > lo { hi } else { lo + 1.0 };
-        let step = nice_step((hi - lo) / 5.0);
+        let step = nice_step((hi - lo) / TICKS);
         Axis {
             lo: (lo / step).floor() * step,
             hi: (hi / step).ceil() * step,
@@ -389,7 +396,7 @@ impl Axis {
             }
             ticks
         } else {
-            let step = nice_step((self.hi - self.lo) / 5.0);
+            let step = nice_step((self.hi - self.lo) / TICKS);
             let n = ((self.hi - self.lo) / step).round() as i64;
             let decimals = (-step.log10().floor()).max(0.0) as usize;
             (0..=n)
