@@ -658,6 +658,37 @@ impl Config {
                     "give `ratios = [0.5, 0.25]` and/or `errors = [0.01]`",
                 ));
             }
+            if let Some(g) = &a.generate {
+                let ratios = g.ratios.windows(2).find(|w| w[1].0 >= w[0].0);
+                let errors = g.errors.windows(2).find(|w| w[1].0 <= w[0].0);
+                if let Some((w, what)) = ratios
+                    .map(|w| (w, "ratios must decrease"))
+                    .or(errors.map(|w| (w, "errors must increase")))
+                {
+                    return Err(fail(
+                        &quoted,
+                        format!(
+                            "asset '{}': generate {what} from one LOD to the next ({} then {}): \
+                             each LOD of the chain is simplified from the one before",
+                            a.name.0, w[0].0, w[1].0
+                        ),
+                        "order them from the finest LOD to the coarsest, e.g. ratios = [0.5, 0.25]",
+                    ));
+                }
+                let lods = g.ratios.len() + g.errors.len();
+                if g.switch_m.len() > lods {
+                    return Err(fail(
+                        &quoted,
+                        format!(
+                            "asset '{}': generate has {} switch_m values for {lods} LODs",
+                            a.name.0,
+                            g.switch_m.len()
+                        ),
+                        "give one switch distance per generated LOD (ratios first, then errors), \
+                         or fewer",
+                    ));
+                }
+            }
             let mut lod_names = std::collections::BTreeSet::new();
             for (name, _) in self.lod_names(a) {
                 if !lod_names.insert(name.clone()) {
@@ -841,6 +872,30 @@ mod tests {
                 "{extra}: {msg}"
             );
         }
+    }
+
+    #[test]
+    fn a_chain_must_get_coarser() {
+        for (generate, word) in [
+            ("ratios = [0.25, 0.5]", "0.25 then 0.5"),
+            ("ratios = [0.5, 0.5]", "0.5 then 0.5"),
+            ("ratios = [0.501, 0.502]", "0.501 then 0.502"),
+            ("errors = [0.02, 0.01]", "0.02 then 0.01"),
+        ] {
+            let text = format!(
+                "[[asset]]\nname = \"a\"\nmesh = \"a.obj\"\ngenerate = {{ method = \"meshopt\", {generate} }}\n"
+            );
+            let msg = parse(&text).unwrap_err().to_string();
+            assert!(
+                msg.contains(word) && msg.contains("t.toml") && msg.contains("line 2"),
+                "{generate}: {msg}"
+            );
+        }
+        let fine = "[[asset]]\nname = \"a\"\nmesh = \"a.obj\"\ngenerate = { method = \"meshopt\", ratios = [0.5, 0.25], errors = [0.01, 0.02] }\n";
+        assert!(parse(fine).is_ok());
+        let extra = "[[asset]]\nname = \"a\"\nmesh = \"a.obj\"\ngenerate = { method = \"meshopt\", ratios = [0.5], switch_m = [3.0, 6.0] }\n";
+        let msg = parse(extra).unwrap_err().to_string();
+        assert!(msg.contains("2 switch_m values for 1 LODs"), "{msg}");
     }
 
     #[test]

@@ -11,7 +11,7 @@
 
 use std::path::{Path, PathBuf};
 
-use super::config::{Config, Thresholds, config_dir, resolve};
+use super::config::{Config, MetricFamily, Thresholds, config_dir, resolve};
 use crate::error::{Error, Result};
 use crate::simplify::{Goal, Method};
 
@@ -174,12 +174,50 @@ impl Plan {
                 lods,
             });
         }
-        Ok(Plan {
+        let plan = Plan {
             config,
             config_path: config_path.to_path_buf(),
             config_text: text,
             assets,
-        })
+        };
+        plan.check_gate()?;
+        Ok(plan)
+    }
+
+    /// The gate's checks that need no results, so that a config the gate cannot judge fails
+    /// before the first render (not after all of them, without `junit.xml`): every threshold's
+    /// metric is computed, and every `switch_m` has distances to be checked against.
+    fn check_gate(&self) -> Result<()> {
+        let computed = &self.config.metrics;
+        for asset in &self.assets {
+            for lod in &asset.lods {
+                for limit in &lod.limits {
+                    let (family, family_name) = threshold_family(limit.name);
+                    if !computed.contains(&family) {
+                        return Err(Error::input(
+                            &self.config_path,
+                            format!(
+                                "threshold {} (set in {}) needs the metric family '{}', which \
+                                 the config does not compute",
+                                limit.name, limit.origin, family_name
+                            ),
+                            "add its family to `metrics` or remove the threshold",
+                        ));
+                    }
+                }
+                if lod.switch_m.is_some() && !self.config.distance.enabled {
+                    return Err(Error::input(
+                        &self.config_path,
+                        format!(
+                            "asset '{}' LOD '{}' has switch_m but distances are disabled",
+                            asset.name, lod.name
+                        ),
+                        "set [distance] enabled = true or remove switch_m",
+                    ));
+                }
+            }
+        }
+        Ok(())
     }
 
     /// Every case id in plan order.
@@ -188,6 +226,17 @@ impl Plan {
             .iter()
             .flat_map(|a| a.lods.iter().map(|l| case_id(&a.name, &l.name)))
             .collect()
+    }
+}
+
+/// The metric family a threshold bounds, and its name in `metrics`.
+fn threshold_family(name: &str) -> (MetricFamily, &'static str) {
+    match name {
+        "flip_mean" | "flip_worst_view" | "flip_p95" | "flip_share" => (MetricFamily::Flip, "flip"),
+        "vdp_probability" => (MetricFamily::Vdp, "vdp"),
+        "psnr_min" => (MetricFamily::Psnr, "psnr"),
+        "ssim_min" => (MetricFamily::Ssim, "ssim"),
+        _ => (MetricFamily::Msssim, "msssim"),
     }
 }
 

@@ -217,8 +217,10 @@ fn by_material(
         let group = indices.len() / 3;
         let (target_count, target_error) = match target {
             Target::Triangles(n) => {
+                // meshoptimizer asserts (aborts the process) on a target above its input, which
+                // a chained goal can ask for when an earlier LOD stopped short of its own.
                 let share = (n as f64 * group as f64 / tris.len() as f64).round() as usize;
-                (share.max(1) * 3, f32::MAX)
+                (share.clamp(1, group) * 3, f32::MAX)
             }
             Target::Error(e) => (0, e),
         };

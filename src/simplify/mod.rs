@@ -74,6 +74,16 @@ pub enum Goal {
     Error(f64),
 }
 
+impl std::fmt::Display for Goal {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Goal::Ratio(r) => write!(f, "ratio {r}"),
+            Goal::Triangles(t) => write!(f, "{t} triangles"),
+            Goal::Error(e) => write!(f, "error {e}"),
+        }
+    }
+}
+
 /// A LOD and the simplifier's own error estimate for it (model units), where it has one.
 #[derive(Debug, Clone)]
 pub struct Lod {
@@ -160,7 +170,12 @@ pub(crate) fn flatten(lod: &Mesh) -> Result<Mesh> {
 ///
 /// Meshes split only by normals are simplified welded, and flat-shaded originals get flat LODs
 /// (see `normal_only_seams`).
+///
+/// Goals are checked first (a usage error, exit 2): a triangle goal may not exceed the mesh, and
+/// consecutive goals of one kind must get strictly coarser (ratios and triangle counts
+/// decreasing, errors increasing), since each LOD of a chain is simpler than the one before.
 pub fn chain(mesh: &Mesh, method: Method, goals: &[Goal]) -> Result<Vec<Lod>> {
+    check_goals(mesh.triangle_count(), goals)?;
     if let Some((welded, flat)) = normal_only_seams(mesh) {
         let lods = chain_of(&welded, method, goals)?;
         return lods
@@ -174,6 +189,43 @@ pub fn chain(mesh: &Mesh, method: Method, goals: &[Goal]) -> Result<Vec<Lod>> {
             .collect();
     }
     chain_of(mesh, method, goals)
+}
+
+/// The checks of [`chain`]'s goals against a mesh of `triangles` triangles.
+pub fn check_goals(triangles: usize, goals: &[Goal]) -> Result<()> {
+    for g in goals {
+        match *g {
+            Goal::Ratio(r) | Goal::Error(r) if !(r.is_finite() && r > 0.0 && r <= 1.0) => {
+                return Err(Error::Usage(format!(
+                    "goal {r} is outside (0, 1]: ratios and relative errors are fractions"
+                )));
+            }
+            Goal::Triangles(t) if t == 0 || t > triangles => {
+                return Err(Error::Usage(format!(
+                    "a goal of {t} triangles is outside 1..={triangles} (the mesh has {triangles}): \
+                     give a smaller count, or --ratio"
+                )));
+            }
+            _ => {}
+        }
+    }
+    for pair in goals.windows(2) {
+        let coarser = match (pair[0], pair[1]) {
+            (Goal::Ratio(a), Goal::Ratio(b)) => b < a,
+            (Goal::Triangles(a), Goal::Triangles(b)) => b < a,
+            (Goal::Error(a), Goal::Error(b)) => b > a,
+            _ => true,
+        };
+        if !coarser {
+            return Err(Error::Usage(format!(
+                "the chain's goals {} then {} do not get coarser: each LOD of a chain must be \
+                 simpler than the one before; order ratios from the largest to the smallest \
+                 (e.g. 0.5,0.25)",
+                pair[0], pair[1]
+            )));
+        }
+    }
+    Ok(())
 }
 
 fn chain_of(mesh: &Mesh, method: Method, goals: &[Goal]) -> Result<Vec<Lod>> {
@@ -267,6 +319,55 @@ fn chain_of(mesh: &Mesh, method: Method, goals: &[Goal]) -> Result<Vec<Lod>> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn goals_are_checked_before_any_simplifier_runs() {
+        let mesh = crate::mesh::shapes::icosphere(2); // 320 triangles
+        let n = mesh.triangle_count();
+        for (goals, word) in [
+            (
+                vec![Goal::Ratio(0.25), Goal::Ratio(0.5)],
+                "do not get coarser",
+            ),
+            (
+                vec![Goal::Ratio(0.501), Goal::Ratio(0.502)],
+                "do not get coarser",
+            ),
+            (vec![Goal::Triangles(n + 1)], "outside 1..=320"),
+            (vec![Goal::Triangles(0)], "outside 1..=320"),
+            (vec![Goal::Ratio(f64::NAN)], "outside (0, 1]"),
+            (
+                vec![Goal::Error(0.02), Goal::Error(0.01)],
+                "do not get coarser",
+            ),
+        ] {
+            for method in [Method::Meshopt, Method::MeshoptUpdate, Method::Qem] {
+                match chain(&mesh, method, &goals) {
+                    Err(Error::Usage(msg)) => assert!(msg.contains(word), "{goals:?}: {msg}"),
+                    other => panic!("{goals:?} with {method:?}: {:?}", other.map(|l| l.len())),
+                }
+            }
+        }
+        // The whole mesh is a valid goal; a chain may mix kinds.
+        let lods = chain(
+            &mesh,
+            Method::Meshopt,
+            &[Goal::Triangles(n), Goal::Ratio(0.5), Goal::Error(0.05)],
+        )
+        .unwrap();
+        assert_eq!(lods.len(), 3);
+    }
+
+    #[test]
+    fn meshoptimizer_is_never_asked_for_more_than_its_input() {
+        // Its assertion would abort the process; the target is clamped to each group's size.
+        let mesh = crate::mesh::shapes::icosphere(2);
+        let n = mesh.triangle_count();
+        let s = meshopt::simplify(&mesh, meshopt::Target::Triangles(4 * n)).unwrap();
+        assert_eq!(s.mesh.triangle_count(), n);
+        let s = meshopt::simplify_updating(&mesh, meshopt::Target::Triangles(4 * n)).unwrap();
+        assert_eq!(s.mesh.triangle_count(), n);
+    }
 
     #[test]
     fn flat_shaded_meshes_simplify_and_stay_flat() {

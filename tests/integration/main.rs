@@ -8,6 +8,8 @@
 //! - `eval`: the batch evaluator (determinism, shards, gate, golden images, bad configs, LOD
 //!   chains on every shipped model).
 //! - `fuzz`: property-based mutation fuzzing of the OBJ, PLY, OFF and GLB paths.
+//! - `hostile`: hostile input by class (`hostile/mod.rs` lists them): refused with exit 2, never
+//!   an abort, a hang or a silently wrong pass.
 //! - `optimize`: `lodeval optimize` (Lindstrom–Turk): energy goes down, the vertex count stays,
 //!   the output is identical for 1, 2 and 8 threads; bad input exits 2.
 //! - `oracles`: metrics against reference implementations (FLIP: NVIDIA's; SSIM/PSNR: scikit-image).
@@ -26,6 +28,7 @@ mod eval;
 mod fuzz;
 #[cfg(feature = "gpu")]
 mod gpu;
+mod hostile;
 mod models;
 mod optimize;
 mod oracles;

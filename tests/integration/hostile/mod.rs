@@ -1,0 +1,48 @@
+//! Hostile input, one module per class of failure (the second round of attacks on the tool): each
+//! crafted input must end in exit 2 with one message naming the culprit and what to do, never in
+//! an abort, a hang or a silently wrong exit 0.
+//!
+//! - `goals`: simplification goals the simplifier cannot take (a chain that does not get coarser,
+//!   more triangles than the mesh has), which used to abort in meshoptimizer's assertion.
+//! - `plan`: configs the gate cannot judge (a threshold on a metric not computed, `switch_m`
+//!   without distances, more `switch_m` values than LODs), refused before the first render.
+
+mod goals;
+mod plan;
+
+use std::path::{Path, PathBuf};
+
+use crate::common::Run;
+
+/// A fresh folder for one test.
+pub fn scratch(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("lodeval-hostile-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+/// Asserts that `r` is an input or usage error (exit 2) whose message holds every one of
+/// `words`, and that nothing panicked.
+pub fn assert_refused(r: &Run, what: &str, words: &[&str]) {
+    assert_eq!(
+        r.code, 2,
+        "{what}: expected exit 2, got {}: {}",
+        r.code, r.stderr
+    );
+    assert!(!r.stderr.contains("panicked"), "{what}: {}", r.stderr);
+    for w in words {
+        assert!(
+            r.stderr.contains(w),
+            "{what}: '{w}' missing from: {}",
+            r.stderr
+        );
+    }
+}
+
+/// Writes `text` to `dir/name` and returns the path.
+pub fn write(dir: &Path, name: &str, text: &str) -> PathBuf {
+    let p = dir.join(name);
+    std::fs::write(&p, text).unwrap();
+    p
+}
