@@ -13,7 +13,7 @@ use std::path::Path;
 use super::config::config_dir;
 use super::plan::Plan;
 use super::tables::{Results, SummaryRow, higher_is_worse, read_csv};
-use crate::error::{Error, Result};
+use crate::error::{Error, Location, Result};
 
 /// One failed check.
 #[derive(Debug, Clone, PartialEq)]
@@ -135,20 +135,110 @@ pub fn check(plan: &Plan, results: &Results) -> Result<Vec<Failure>> {
     Ok(failures)
 }
 
-/// Compare summary means with a baseline `summary.csv`.
+/// A baseline `summary.csv` that can judge a run: at least one row, every mean a finite number.
+/// Anything else is an input error (exit 2), never a gate that passes because nothing was
+/// compared.
+pub fn read_baseline(path: &Path) -> Result<Vec<SummaryRow>> {
+    const FIX: &str = "point [gate] baseline at the summary.csv of an earlier run of this config";
+    let base: Vec<SummaryRow> = read_csv(path)?;
+    if base.is_empty() {
+        return Err(Error::input(
+            path,
+            "the baseline holds no rows (an empty file or a header only), so it cannot judge a run",
+            FIX,
+        ));
+    }
+    if let Some(i) = base.iter().position(|b| !b.mean.is_finite()) {
+        return Err(Error::input_at(
+            path,
+            Location::Line(i + 2),
+            format!(
+                "the baseline's mean for {}/{} {} is not a finite number",
+                base[i].asset, base[i].lod, base[i].metric
+            ),
+            FIX,
+        ));
+    }
+    Ok(base)
+}
+
+/// The baseline of `plan`, if it has one, checked before the first render: readable, usable
+/// ([`read_baseline`]), and holding rows for at least one of the plan's assets (a baseline of
+/// another config compares nothing).
+pub fn check_baseline(plan: &Plan) -> Result<()> {
+    let Some(baseline) = &plan.config.gate.baseline else {
+        return Ok(());
+    };
+    let path = super::config::resolve(&config_dir(&plan.config_path), baseline);
+    let base = read_baseline(&path)?;
+    if !base
+        .iter()
+        .any(|b| plan.assets.iter().any(|a| a.name == b.asset))
+    {
+        let mut theirs: Vec<&str> = base.iter().map(|b| b.asset.as_str()).collect();
+        theirs.dedup();
+        return Err(Error::input(
+            &path,
+            format!(
+                "the baseline has no rows for any asset of {} (it has rows for: {})",
+                plan.config_path.display(),
+                theirs.join(", ")
+            ),
+            "point [gate] baseline at the summary.csv of an earlier run of this config",
+        ));
+    }
+    Ok(())
+}
+
+/// Compare summary means with a baseline `summary.csv`: a mean worse than the baseline's beyond
+/// the tolerance, a mean that is not a number, and a LOD or metric the baseline lacks all fail.
 pub fn against_baseline(
     path: &Path,
     current: &[SummaryRow],
     tolerance: f64,
     absolute: f64,
 ) -> Result<Vec<Failure>> {
-    let base: Vec<SummaryRow> = read_csv(path)?;
+    let base = read_baseline(path)?;
     let mut out = Vec::new();
+    let mut missing_lods: Vec<(&str, &str)> = Vec::new();
     for row in current {
+        let key = (row.asset.as_str(), row.lod.as_str());
+        if !base.iter().any(|b| b.asset == key.0 && b.lod == key.1) {
+            // A LOD the baseline has never seen is reported once, not passed.
+            if !missing_lods.contains(&key) {
+                missing_lods.push(key);
+                out.push(Failure {
+                    asset: row.asset.clone(),
+                    lod: row.lod.clone(),
+                    check: "baseline".into(),
+                    message: format!(
+                        "FAIL {}/{} baseline: the LOD is not in the baseline {}, so nothing was \
+                         compared; if it is new, make this run's summary.csv the baseline",
+                        row.asset,
+                        row.lod,
+                        path.display()
+                    ),
+                });
+            }
+            continue;
+        }
+        let check = format!("baseline:{}", row.metric);
         let Some(b) = base
             .iter()
             .find(|b| b.asset == row.asset && b.lod == row.lod && b.metric == row.metric)
         else {
+            out.push(Failure {
+                asset: row.asset.clone(),
+                lod: row.lod.clone(),
+                message: format!(
+                    "FAIL {}/{} {check}: the baseline {} has this LOD but not the metric; make \
+                     this run's summary.csv the baseline if the metric is new",
+                    row.asset,
+                    row.lod,
+                    path.display()
+                ),
+                check,
+            });
             continue;
         };
         let slack = tolerance * b.mean.abs() + absolute;
@@ -157,7 +247,7 @@ pub fn against_baseline(
         } else {
             row.mean < b.mean - slack
         };
-        if worse && row.mean.is_finite() {
+        if worse || !row.mean.is_finite() {
             let check = format!("baseline:{}", row.metric);
             out.push(Failure {
                 asset: row.asset.clone(),

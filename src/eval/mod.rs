@@ -71,6 +71,7 @@ pub fn eval(
     progress: &dyn crate::progress::Progress,
 ) -> Result<Outcome> {
     let plan = Plan::load(config)?;
+    gate::check_baseline(&plan)?;
     let out = run::run(plan, options, progress)?;
     let manifest = Manifest {
         config_path: out.plan.config_path.clone(),

@@ -6,7 +6,10 @@
 //!   more triangles than the mesh has), which used to abort in meshoptimizer's assertion.
 //! - `plan`: configs the gate cannot judge (a threshold on a metric not computed, `switch_m`
 //!   without distances, more `switch_m` values than LODs), refused before the first render.
+//! - `baseline`: gate baselines that hold nothing usable (empty, a header only, prose, a folder,
+//!   `/dev/zero`, another config's assets, NaN), refused; a LOD the baseline lacks fails the gate.
 
+mod baseline;
 mod goals;
 mod plan;
 
