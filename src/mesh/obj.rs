@@ -1,11 +1,14 @@
 //! Wavefront OBJ + MTL loader (parsing by `tobj`).
 //!
-//! Steps: read and UTF-8-check the file; `scan` it once ourselves, which (a) gives line numbers
+//! Steps: read and UTF-8-check the file (a byte-order mark dropped, Latin-1 accepted in comments
+//! and names only); `scan` it once ourselves, which (a) gives line numbers
 //! for every error `tobj` would only name by kind (bad numbers, NaN coordinates, face indices out of
 //! range or before their vertex), (b) counts records for `lodeval info`, and (c) moves `mtllib`
 //! lines to the front, because `tobj` binds `usemtl` names only to libraries already read and some
-//! exporters write `mtllib` last (Crane's Bob); then `tobj` parses the text, and we build vertices
-//! from the distinct (position, UV, normal) index triples, so seams split vertices.
+//! exporters write `mtllib` last (Crane's Bob); then `tobj` parses the text, every `usemtl` is
+//! checked against the materials the libraries define (an undefined one is a missing asset), and
+//! we build vertices from the distinct (position, UV, normal) index triples, so seams split
+//! vertices.
 //!
 //! Decisions: `l` and `p` records (lines, points) are ignored; polygons are fan-triangulated by
 //! `tobj`; OBJ vertex colours are taken as sRGB-encoded values in 0..1 and linearised; `map_Bump`,
@@ -35,6 +38,8 @@ struct Scan {
     partial_colors: bool,
     faces: usize,
     mtllibs: Vec<(usize, String)>,
+    /// Every `usemtl` line and the material it names (as `tobj` reads the name).
+    usemtls: Vec<(usize, String)>,
     /// The text with every `mtllib`, `l` and `p` line blanked and the `mtllib` lines prepended.
     text: String,
 }
@@ -128,6 +133,7 @@ fn scan(path: &Path, text: &str) -> Result<Scan> {
     let mut colored = 0;
     let mut referenced: Vec<bool> = Vec::new();
     let mut mtllibs = Vec::new();
+    let mut usemtls = Vec::new();
     let mut body = String::with_capacity(text.len() + 64);
     for (i, raw) in text.split('\n').enumerate() {
         let line_no = i + 1;
@@ -210,6 +216,18 @@ fn scan(path: &Path, text: &str) -> Result<Scan> {
                 mtllibs.push((line_no, name.to_string()));
                 false
             }
+            Some("usemtl") => {
+                let name = line
+                    .trim_start()
+                    .split_once(' ')
+                    .unwrap_or_default()
+                    .1
+                    .trim();
+                if !name.is_empty() {
+                    usemtls.push((line_no, name.to_string()));
+                }
+                true
+            }
             Some("l") | Some("p") => false,
             _ => true,
         };
@@ -248,7 +266,54 @@ fn scan(path: &Path, text: &str) -> Result<Scan> {
         partial_colors,
         faces,
         mtllibs,
+        usemtls,
         text,
+    })
+}
+
+/// The file's text: UTF-8 without a leading byte-order mark (which would glue itself to the first
+/// record and drop it). Real exporters write Latin-1 in comments and object or group names, so a
+/// line that is not UTF-8 is accepted there (read as Latin-1, where it is never used); anywhere
+/// else it is an error naming the line.
+fn decode(path: &Path, bytes: Vec<u8>) -> Result<String> {
+    let text = match String::from_utf8(bytes) {
+        Ok(text) => text,
+        Err(e) => {
+            let bytes = e.into_bytes();
+            let mut text = String::with_capacity(bytes.len() + 16);
+            for (i, line) in bytes.split(|&b| b == b'\n').enumerate() {
+                if i > 0 {
+                    text.push('\n');
+                }
+                match std::str::from_utf8(line) {
+                    Ok(l) => text.push_str(l),
+                    Err(_) => {
+                        let key = line
+                            .iter()
+                            .skip_while(|b| b.is_ascii_whitespace())
+                            .take_while(|b| !b.is_ascii_whitespace())
+                            .copied()
+                            .collect::<Vec<u8>>();
+                        let free_text = key.first() == Some(&b'#') || key == b"o" || key == b"g";
+                        if !free_text {
+                            return Err(Error::input_at(
+                                path,
+                                Location::Line(i + 1),
+                                "the line is not text (invalid UTF-8; only comments and o/g \
+                                 names may hold other bytes); is it really an OBJ file?",
+                                "re-export it as a UTF-8 text OBJ",
+                            ));
+                        }
+                        text.extend(line.iter().map(|&b| b as char));
+                    }
+                }
+            }
+            text
+        }
+    };
+    Ok(match text.strip_prefix('\u{feff}') {
+        Some(rest) => rest.to_string(),
+        None => text,
     })
 }
 
@@ -283,17 +348,7 @@ fn check_mtl(path: &Path) -> Result<()> {
 
 /// Load an OBJ file and the MTL libraries and textures it names.
 pub(crate) fn load(path: &Path, options: &LoadOptions) -> Result<MeshData> {
-    let bytes = read_file(path)?;
-    let text = String::from_utf8(bytes).map_err(|e| {
-        let valid = &e.as_bytes()[..e.utf8_error().valid_up_to()];
-        let line = valid.iter().filter(|&&b| b == b'\n').count() + 1;
-        Error::input_at(
-            path,
-            Location::Line(line),
-            "the file is not text (invalid UTF-8); is it really an OBJ file?",
-            "re-export it as a text OBJ",
-        )
-    })?;
+    let text = decode(path, read_file(path)?)?;
     let scan = scan(path, &text)?;
     let dir = path.parent().unwrap_or(Path::new(".")).to_path_buf();
     let mut warnings = Vec::new();
@@ -364,6 +419,38 @@ pub(crate) fn load(path: &Path, options: &LoadOptions) -> Result<MeshData> {
         ));
     }
     let tobj_materials = materials.unwrap_or_default();
+    // A `usemtl` naming a material no library defines is a missing asset like a missing
+    // library: tobj would quietly give those faces the default material.
+    for (line_no, name) in &scan.usemtls {
+        if tobj_materials.iter().any(|m| &m.name == name) {
+            continue;
+        }
+        let libraries: Vec<&str> = scan.mtllibs.iter().map(|(_, n)| n.as_str()).collect();
+        let problem = if libraries.is_empty() {
+            format!("usemtl names material '{name}', but the file has no mtllib line")
+        } else {
+            format!(
+                "usemtl names material '{name}', which no material library defines ({})",
+                libraries.join(", ")
+            )
+        };
+        match options.missing_assets {
+            MissingAssets::Error => {
+                return Err(Error::input_at(
+                    path,
+                    Location::Line(*line_no),
+                    problem,
+                    "add the material to its .mtl file (newmtl NAME), fix the usemtl line, or \
+                     pass --missing-assets warn to use the default material",
+                ));
+            }
+            MissingAssets::Warn => {
+                if !warnings.contains(&problem) {
+                    warnings.push(problem)
+                }
+            }
+        }
+    }
 
     // Materials and their textures (decoded once, shared).
     let mut cache = TextureCache::default();

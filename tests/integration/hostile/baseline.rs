@@ -19,7 +19,8 @@ fn config(dir: &std::path::Path, baseline: &str, ratios: &str) -> std::path::Pat
 
 #[test]
 fn an_unusable_baseline_is_an_input_error_before_rendering() {
-    let d = scratch("baseline");
+    let tmp = scratch("baseline");
+    let d = tmp.path();
     // A real summary to take rows and the header from.
     let cfg = config(&d, "", "0.5");
     let r = lodeval(["eval".as_ref(), cfg.as_os_str()]);
@@ -79,7 +80,8 @@ fn an_unusable_baseline_is_an_input_error_before_rendering() {
 
 #[test]
 fn a_lod_the_baseline_lacks_fails_the_gate() {
-    let d = scratch("baseline-missing");
+    let tmp = scratch("baseline-missing");
+    let d = tmp.path();
     let cfg = config(&d, "", "0.5");
     assert_eq!(lodeval(["eval".as_ref(), cfg.as_os_str()]).code, 0);
     std::fs::copy(d.join("out/summary.csv"), d.join("base.csv")).unwrap();

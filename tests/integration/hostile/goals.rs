@@ -6,7 +6,8 @@ use crate::common::{lodeval, model, simplify};
 
 #[test]
 fn a_chain_that_does_not_get_coarser_is_refused() {
-    let d = scratch("chain");
+    let tmp = scratch("chain");
+    let d = tmp.path();
     let spot = model("spot/spot_mtl.obj");
     for (chain, seen) in [
         ("0.25,0.5", "ratio 0.25 then ratio 0.5"),
@@ -30,7 +31,8 @@ fn a_chain_that_does_not_get_coarser_is_refused() {
 
 #[test]
 fn more_triangles_than_the_mesh_has_is_refused() {
-    let d = scratch("triangles");
+    let tmp = scratch("triangles");
+    let d = tmp.path();
     let spot = model("spot/spot_mtl.obj"); // 5 856 triangles
     for method in ["meshopt", "meshopt-update", "qem", "cluster"] {
         let r = simplify(
@@ -47,7 +49,8 @@ fn more_triangles_than_the_mesh_has_is_refused() {
 
 #[test]
 fn a_config_chain_that_does_not_get_coarser_names_the_file_and_line() {
-    let d = scratch("config-chain");
+    let tmp = scratch("config-chain");
+    let d = tmp.path();
     let mesh = model("spot/spot_mtl.obj");
     for (generate, seen) in [
         ("ratios = [0.25, 0.5]", "0.25 then 0.5"),

@@ -8,21 +8,24 @@
 //!   without distances, more `switch_m` values than LODs), refused before the first render.
 //! - `baseline`: gate baselines that hold nothing usable (empty, a header only, prose, a folder,
 //!   `/dev/zero`, another config's assets, NaN), refused; a LOD the baseline lacks fails the gate.
+//! - `obj_text`: OBJ text that loaded wrong (a byte-order mark, `usemtl` of an undefined
+//!   material) or not at all (Latin-1 in a comment).
 
 mod baseline;
 mod goals;
+mod obj_text;
 mod plan;
 
 use std::path::{Path, PathBuf};
 
 use crate::common::Run;
 
-/// A fresh folder for one test.
-pub fn scratch(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("lodeval-hostile-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
+/// A fresh folder for one test, removed when it is dropped.
+pub fn scratch(name: &str) -> tempfile::TempDir {
+    tempfile::Builder::new()
+        .prefix(&format!("lodeval-hostile-{name}-"))
+        .tempdir()
+        .unwrap()
 }
 
 /// Asserts that `r` is an input or usage error (exit 2) whose message holds every one of

@@ -23,7 +23,8 @@ fn config(dir: &std::path::Path, body: &str) -> std::path::PathBuf {
 
 #[test]
 fn a_threshold_on_a_metric_not_computed_fails_before_rendering() {
-    let d = scratch("plan-metric");
+    let tmp = scratch("plan-metric");
+    let d = tmp.path();
     for (body, words) in [
         (
             "metrics = [\"flip\"]\n[thresholds]\nssim_min = 0.9",
@@ -46,7 +47,8 @@ fn a_threshold_on_a_metric_not_computed_fails_before_rendering() {
 
 #[test]
 fn switch_distances_without_the_distance_search_fail_before_rendering() {
-    let d = scratch("plan-switch");
+    let tmp = scratch("plan-switch");
+    let d = tmp.path();
     let body = "metrics = [\"flip\"]\n# switch\n[distance]\nenabled = false";
     let r = lodeval(["eval".as_ref(), config(&d, body).as_os_str()]);
     assert_refused(
@@ -59,7 +61,8 @@ fn switch_distances_without_the_distance_search_fail_before_rendering() {
 
 #[test]
 fn more_switch_distances_than_lods_is_refused() {
-    let d = scratch("plan-extra-switch");
+    let tmp = scratch("plan-extra-switch");
+    let d = tmp.path();
     let mesh = model("bunny/bunny_odedstein_3k.obj");
     let path = write(
         &d,
