@@ -22,7 +22,7 @@ fn an_unusable_baseline_is_an_input_error_before_rendering() {
     let tmp = scratch("baseline");
     let d = tmp.path();
     // A real summary to take rows and the header from.
-    let cfg = config(&d, "", "0.5");
+    let cfg = config(d, "", "0.5");
     let r = lodeval(["eval".as_ref(), cfg.as_os_str()]);
     assert_eq!(r.code, 0, "{}", r.stderr);
     let summary = std::fs::read_to_string(d.join("out/summary.csv")).unwrap();
@@ -63,16 +63,16 @@ fn an_unusable_baseline_is_an_input_error_before_rendering() {
     ];
     for (name, text, words) in cases {
         if let Some(text) = text {
-            write(&d, name, &text);
+            write(d, name, &text);
         }
-        let cfg = config(&d, &format!("[gate]\nbaseline = \"{name}\""), "0.5");
+        let cfg = config(d, &format!("[gate]\nbaseline = \"{name}\""), "0.5");
         let r = lodeval(["eval".as_ref(), cfg.as_os_str()]);
         assert_refused(&r, name, words);
         assert!(!d.join("out").exists(), "{name}: rendered before refusing");
     }
     #[cfg(unix)]
     {
-        let cfg = config(&d, "[gate]\nbaseline = \"/dev/zero\"", "0.5");
+        let cfg = config(d, "[gate]\nbaseline = \"/dev/zero\"", "0.5");
         let r = lodeval(["eval".as_ref(), cfg.as_os_str()]);
         assert_refused(&r, "/dev/zero", &["/dev/zero", "not a regular file"]);
     }
@@ -82,11 +82,11 @@ fn an_unusable_baseline_is_an_input_error_before_rendering() {
 fn a_lod_the_baseline_lacks_fails_the_gate() {
     let tmp = scratch("baseline-missing");
     let d = tmp.path();
-    let cfg = config(&d, "", "0.5");
+    let cfg = config(d, "", "0.5");
     assert_eq!(lodeval(["eval".as_ref(), cfg.as_os_str()]).code, 0);
     std::fs::copy(d.join("out/summary.csv"), d.join("base.csv")).unwrap();
     // The same config with a second LOD: the baseline has never seen it.
-    let cfg = config(&d, "[gate]\nbaseline = \"base.csv\"", "0.5, 0.25");
+    let cfg = config(d, "[gate]\nbaseline = \"base.csv\"", "0.5, 0.25");
     let r = lodeval(["eval".as_ref(), cfg.as_os_str()]);
     assert_eq!(r.code, 1, "{}", r.stderr);
     assert!(

@@ -24,7 +24,7 @@ fn a_chain_that_does_not_get_coarser_is_refused() {
         }
     }
     assert!(
-        std::fs::read_dir(&d).unwrap().next().is_none(),
+        std::fs::read_dir(d).unwrap().next().is_none(),
         "a refused chain wrote files"
     );
 }
@@ -58,7 +58,7 @@ fn a_config_chain_that_does_not_get_coarser_names_the_file_and_line() {
         ("errors = [0.05, 0.01]", "0.05 then 0.01"),
     ] {
         let config = write(
-            &d,
+            d,
             "bad.toml",
             &format!(
                 "out = \"out\"\n[[asset]]\nname = \"spot\"\nmesh = \"{}\"\ngenerate = {{ method = \"meshopt\", {generate} }}\n",

@@ -80,7 +80,7 @@ fn latin1_in_comments_and_names_is_accepted_and_elsewhere_refused() {
     let (code, out, err) = info_json(&d.join("latin1.obj"));
     assert_eq!(code, 0, "{err}");
     assert!(out.contains("\"triangles\": 2"), "{out}");
-    let mut bad = format!("{QUAD}").into_bytes();
+    let mut bad = QUAD.to_string().into_bytes();
     bad.extend_from_slice(b"f 1/1 2/2 3/3 4\xe9\n");
     std::fs::write(d.join("bad.obj"), &bad).unwrap();
     let r = lodeval(["info".as_ref(), d.join("bad.obj").as_os_str()]);

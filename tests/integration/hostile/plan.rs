@@ -39,7 +39,7 @@ fn a_threshold_on_a_metric_not_computed_fails_before_rendering() {
             &["flip_p95", "'flip'"][..],
         ),
     ] {
-        let r = lodeval(["eval".as_ref(), config(&d, body).as_os_str()]);
+        let r = lodeval(["eval".as_ref(), config(d, body).as_os_str()]);
         assert_refused(&r, body, words);
         assert!(!d.join("out").exists(), "{body}: rendered before refusing");
     }
@@ -50,7 +50,7 @@ fn switch_distances_without_the_distance_search_fail_before_rendering() {
     let tmp = scratch("plan-switch");
     let d = tmp.path();
     let body = "metrics = [\"flip\"]\n# switch\n[distance]\nenabled = false";
-    let r = lodeval(["eval".as_ref(), config(&d, body).as_os_str()]);
+    let r = lodeval(["eval".as_ref(), config(d, body).as_os_str()]);
     assert_refused(
         &r,
         body,
@@ -65,7 +65,7 @@ fn more_switch_distances_than_lods_is_refused() {
     let d = tmp.path();
     let mesh = model("bunny/bunny_odedstein_3k.obj");
     let path = write(
-        &d,
+        d,
         "extra.toml",
         &format!(
             "out = \"out\"\n[[asset]]\nname = \"bunny\"\nmesh = \"{}\"\ngenerate = {{ method = \"meshopt\", ratios = [0.5], switch_m = [2.0, 4.0] }}\n",
