@@ -8,7 +8,7 @@ pub mod plot;
 pub mod plot_png;
 
 use std::io::Write;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use crate::error::{Error, Result};
 
@@ -40,6 +40,36 @@ fn cannot_write(path: &Path, e: std::io::Error) -> Error {
         format!("cannot write the output: {e}"),
         "check that the folder exists and is writable",
     )
+}
+
+/// The folder `path` is in (`.` for a bare file name): where a config's or a mesh's relative
+/// paths start from.
+pub fn parent_dir(path: &Path) -> PathBuf {
+    match path.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
+        _ => PathBuf::from("."),
+    }
+}
+
+/// `base` joined with `rel`, with `dir/..` pairs removed lexically (`configs/../results` →
+/// `results`), so messages show the paths a user would type. Leading `..` stay.
+pub fn resolve(base: &Path, rel: &Path) -> PathBuf {
+    use std::path::Component;
+    let joined = base.join(rel);
+    let mut out: Vec<Component> = Vec::new();
+    for c in joined.components() {
+        match c {
+            Component::CurDir => {}
+            Component::ParentDir if matches!(out.last(), Some(Component::Normal(_))) => {
+                out.pop();
+            }
+            other => out.push(other),
+        }
+    }
+    if out.is_empty() {
+        return PathBuf::from(".");
+    }
+    out.iter().collect()
 }
 
 /// Encode an image in the format its extension names (`.png`, `.exr`) and write it atomically.

@@ -76,10 +76,30 @@ mod tests {
             .collect()
     }
 
-    /// (line, target module) for each `crate::NAME` of a file.
-    fn edges(text: &str) -> Vec<(usize, String)> {
+    /// (line, target module) for each `crate::NAME` of a file, and each `super::…::NAME` whose
+    /// chain of `super` climbs to the crate root (`depth`: how many modules deep the file is).
+    fn edges(text: &str, depth: usize) -> Vec<(usize, String)> {
         let mut out = Vec::new();
         for (i, line) in code_lines(text).iter().enumerate() {
+            let mut rest = line.as_str();
+            while let Some(k) = rest.find("super::") {
+                let before = rest[..k].chars().last();
+                let mut tail = &rest[k..];
+                let mut climbs = 0;
+                while let Some(t) = tail.strip_prefix("super::") {
+                    climbs += 1;
+                    tail = t;
+                }
+                let name: String = tail
+                    .chars()
+                    .take_while(|c| c.is_alphanumeric() || *c == '_')
+                    .collect();
+                let escapes = !before.is_some_and(|c| c.is_alphanumeric() || c == '_' || c == ':');
+                if escapes && climbs >= depth && !name.is_empty() {
+                    out.push((i + 1, name.clone()));
+                }
+                rest = &tail[name.len()..];
+            }
             let mut rest = line.as_str();
             while let Some(k) = rest.find("crate::") {
                 let tail = &rest[k + "crate::".len()..];
@@ -129,7 +149,13 @@ mod tests {
                 continue;
             };
             let text = std::fs::read_to_string(&f).unwrap();
-            for (line, target) in edges(&text) {
+            let parts = rel.components().count();
+            let depth = if rel.ends_with("mod.rs") {
+                parts - 1
+            } else {
+                parts
+            };
+            for (line, target) in edges(&text, depth) {
                 if target == top {
                     continue;
                 }
@@ -178,9 +204,20 @@ mod tests {
             "// crate::eval in a comment\n#[cfg(test)]\nmod tests {\n    use crate::eval::Plan;\n}\n",
         )
         .unwrap();
+        // A `super::super::` chain that climbs to the root and back down into a higher layer.
+        std::fs::write(
+            dir.join("mesh/sneaky.rs"),
+            "//! Relative paths count too.\n\nfn f() {\n    let _ = super::super::eval::config::stem;\n    let _ = super::load;\n}\n",
+        )
+        .unwrap();
         let bad = violations(&dir);
         std::fs::remove_dir_all(&dir).unwrap();
-        assert_eq!(bad.len(), 1, "{bad:?}");
+        assert_eq!(bad.len(), 2, "{bad:?}");
+        assert!(
+            bad[1].starts_with("mesh/sneaky.rs:4: `mesh` (layer 1) uses `crate::eval` (layer 7)"),
+            "{}",
+            bad[1]
+        );
         assert!(
             bad[0].starts_with("mesh/bad.rs:3: `mesh` (layer 1) uses `crate::eval` (layer 7)"),
             "{}",

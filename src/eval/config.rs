@@ -793,34 +793,10 @@ pub fn percent_label(ratio: f64) -> String {
     format!("{p}")
 }
 
-/// The folder a config's relative paths start from.
-pub fn config_dir(config_path: &Path) -> PathBuf {
-    match config_path.parent() {
-        Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
-        _ => PathBuf::from("."),
-    }
-}
-
-/// `base` joined with `rel`, with `dir/..` pairs removed lexically (`configs/../results` →
-/// `results`), so messages show the paths a user would type. Leading `..` stay.
-pub fn resolve(base: &Path, rel: &Path) -> PathBuf {
-    use std::path::Component;
-    let joined = base.join(rel);
-    let mut out: Vec<Component> = Vec::new();
-    for c in joined.components() {
-        match c {
-            Component::CurDir => {}
-            Component::ParentDir if matches!(out.last(), Some(Component::Normal(_))) => {
-                out.pop();
-            }
-            other => out.push(other),
-        }
-    }
-    if out.is_empty() {
-        return PathBuf::from(".");
-    }
-    out.iter().collect()
-}
+/// The folder a config's relative paths start from (the config's own folder).
+pub use crate::io::parent_dir as config_dir;
+/// Relative config paths joined onto that folder, tidied.
+pub use crate::io::resolve;
 
 /// The config's file stem (`demo` for `configs/demo.toml`).
 pub fn stem(config_path: &Path) -> String {

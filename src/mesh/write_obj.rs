@@ -23,7 +23,7 @@ pub fn write(mesh: &Mesh, path: &Path) -> Result<()> {
     let stem = path
         .file_stem()
         .map_or_else(|| "mesh".to_string(), |s| s.to_string_lossy().into_owned());
-    let dir = super::super::eval::config::config_dir(path);
+    let dir = crate::io::parent_dir(path);
     let mut mtl = String::new();
     for (i, m) in mesh.materials().iter().enumerate() {
         let name = safe(&m.name, i);
