@@ -346,6 +346,24 @@ fn check_mtl(path: &Path) -> Result<()> {
     Ok(())
 }
 
+/// A missing asset named at a line of the OBJ: an input error, or with `--missing-assets warn`
+/// a warning.
+fn missing_asset(
+    options: &LoadOptions,
+    warnings: &mut Vec<String>,
+    (path, line): (&Path, usize),
+    problem: String,
+    fix: &str,
+) -> Result<()> {
+    match options.missing_assets {
+        MissingAssets::Error => Err(Error::input_at(path, Location::Line(line), problem, fix)),
+        MissingAssets::Warn => {
+            warnings.push(problem);
+            Ok(())
+        }
+    }
+}
+
 /// Load an OBJ file and the MTL libraries and textures it names.
 pub(crate) fn load(path: &Path, options: &LoadOptions) -> Result<MeshData> {
     let text = decode(path, read_file(path)?)?;
@@ -365,17 +383,13 @@ pub(crate) fn load(path: &Path, options: &LoadOptions) -> Result<MeshData> {
                 "material library '{name}' not found at {}",
                 resolved.display()
             );
-            match options.missing_assets {
-                MissingAssets::Error => {
-                    return Err(Error::input_at(
-                        path,
-                        Location::Line(*line_no),
-                        problem,
-                        "put the .mtl file there, fix the mtllib line, or pass --missing-assets warn to use default materials",
-                    ));
-                }
-                MissingAssets::Warn => warnings.push(problem),
-            }
+            missing_asset(
+                options,
+                &mut warnings,
+                (path, *line_no),
+                problem,
+                "put the .mtl file there, fix the mtllib line, or pass --missing-assets warn to use default materials",
+            )?;
         }
         if resolved.is_file() {
             check_mtl(&resolved)?;
@@ -434,22 +448,17 @@ pub(crate) fn load(path: &Path, options: &LoadOptions) -> Result<MeshData> {
                 libraries.join(", ")
             )
         };
-        match options.missing_assets {
-            MissingAssets::Error => {
-                return Err(Error::input_at(
-                    path,
-                    Location::Line(*line_no),
-                    problem,
-                    "add the material to its .mtl file (newmtl NAME), fix the usemtl line, or \
-                     pass --missing-assets warn to use the default material",
-                ));
-            }
-            MissingAssets::Warn => {
-                if !warnings.contains(&problem) {
-                    warnings.push(problem)
-                }
-            }
+        if warnings.contains(&problem) {
+            continue; // the same undefined material, used again
         }
+        missing_asset(
+            options,
+            &mut warnings,
+            (path, *line_no),
+            problem,
+            "add the material to its .mtl file (newmtl NAME), fix the usemtl line, or pass \
+             --missing-assets warn to use the default material",
+        )?;
     }
 
     // Materials and their textures (decoded once, shared).
