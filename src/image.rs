@@ -38,18 +38,33 @@ impl LinearImage {
     }
 
     /// Load a PNG/JPEG/EXR file: 8-bit files are sRGB-decoded, float files taken as linear.
+    /// Only a regular file of at most [`crate::limits::IMAGE_BYTES`] is read, decoding is bounded
+    /// by the `image` crate's default limits, and a float image with a NaN or infinite pixel is
+    /// refused (a metric would turn it into NaN scores).
     pub fn load(path: &std::path::Path) -> Result<LinearImage> {
-        let img = image::open(path).map_err(|e| {
-            Error::input(
-                path,
-                format!("cannot read the image: {e}"),
-                "give a PNG, JPEG or EXR file",
-            )
-        })?;
+        let fix = "give a PNG, JPEG or EXR file";
+        let bytes = crate::io::read_input(path, "image", crate::limits::IMAGE_BYTES, fix)?;
+        let img = image::ImageReader::new(std::io::Cursor::new(bytes))
+            .with_guessed_format()
+            .map_err(|e| Error::input(path, format!("cannot read the image: {e}"), fix))?
+            .decode()
+            .map_err(|e| Error::input(path, format!("cannot read the image: {e}"), fix))?;
         let (w, h) = (img.width() as usize, img.height() as usize);
         let out = match img {
             image::DynamicImage::ImageRgb32F(_) | image::DynamicImage::ImageRgba32F(_) => {
                 let f = img.into_rgb32f();
+                if let Some((i, _)) = f
+                    .pixels()
+                    .enumerate()
+                    .find(|(_, p)| p.0.iter().any(|c| !c.is_finite()))
+                {
+                    return Err(Error::input_at(
+                        path,
+                        crate::error::Location::Element(format!("pixel ({}, {})", i % w, i / w)),
+                        "the pixel is NaN or infinite, so no metric can score the image",
+                        "re-export the image with finite values (clamp or fill the bad pixels)",
+                    ));
+                }
                 LinearImage::new(w, h, f.pixels().map(|p| Vec3::from(p.0)).collect())
             }
             other => LinearImage::from_srgb8(w, h, other.into_rgb8().as_raw()),

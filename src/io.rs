@@ -1,16 +1,82 @@
-//! Output files: written to a temporary file in the destination folder and renamed into place,
-//! so a crash or a bad input never leaves a half-written output (README, Architecture, "Errors"). The 8-bit
-//! image writers here are the only place where linear colour becomes sRGB bytes on disk.
+//! Files in and out. Inputs are read only from regular files and only up to a size the format
+//! can need ([`read_input`], [`check_input`]), so a FIFO, `/dev/zero` or a symlink to one is an
+//! error, not a hang. Outputs are written to a temporary file in the destination folder and
+//! renamed into place, so a crash or a bad input never leaves a half-written output (README,
+//! Architecture, "Errors"). The 8-bit image writers here are the only place where linear colour
+//! becomes sRGB bytes on disk.
 
 pub mod csv;
 pub mod label;
 pub mod plot;
 pub mod plot_png;
 
-use std::io::Write;
+use std::io::{Read, Write};
 use std::path::{Path, PathBuf};
 
 use crate::error::{Error, Result};
+
+/// Check that `path` is a regular file (symlinks followed) of at most `limit` bytes. `what` names
+/// the file in the message ("mesh", "texture"), `fix` says what to do.
+pub fn check_input(path: &Path, what: &str, limit: u64, fix: &str) -> Result<u64> {
+    let meta = std::fs::metadata(path)
+        .map_err(|e| Error::input(path, format!("cannot read the {what}: {e}"), fix))?;
+    if !meta.is_file() {
+        let kind = if meta.is_dir() {
+            "a folder, not a regular file"
+        } else {
+            "not a regular file (a device, a pipe or a socket)"
+        };
+        return Err(Error::input(
+            path,
+            format!("the {what} is {kind}; lodeval reads only regular files"),
+            fix,
+        ));
+    }
+    if meta.len() > limit {
+        return Err(too_large(path, what, meta.len(), limit, fix));
+    }
+    Ok(meta.len())
+}
+
+fn too_large(path: &Path, what: &str, len: u64, limit: u64, fix: &str) -> Error {
+    Error::input(
+        path,
+        format!("the {what} is {len} bytes, over lodeval's limit of {limit} bytes for a {what}"),
+        fix,
+    )
+}
+
+/// Read a whole input file after [`check_input`]; reads at most `limit` bytes even if the file
+/// grows while it is read.
+pub fn read_input(path: &Path, what: &str, limit: u64, fix: &str) -> Result<Vec<u8>> {
+    let len = check_input(path, what, limit, fix)?;
+    let cannot =
+        |e: std::io::Error| Error::input(path, format!("cannot read the {what}: {e}"), fix);
+    let file = std::fs::File::open(path).map_err(cannot)?;
+    let mut bytes = Vec::with_capacity(len as usize);
+    file.take(limit + 1)
+        .read_to_end(&mut bytes)
+        .map_err(cannot)?;
+    if bytes.len() as u64 > limit {
+        return Err(too_large(path, what, bytes.len() as u64, limit, fix));
+    }
+    Ok(bytes)
+}
+
+/// [`read_input`] for text: the bytes must be UTF-8.
+pub fn read_input_text(path: &Path, what: &str, limit: u64, fix: &str) -> Result<String> {
+    let bytes = read_input(path, what, limit, fix)?;
+    String::from_utf8(bytes).map_err(|e| {
+        Error::input(
+            path,
+            format!(
+                "the {what} is not UTF-8 text (byte {})",
+                e.utf8_error().valid_up_to()
+            ),
+            fix,
+        )
+    })
+}
 
 /// Write `bytes` to `path` atomically (temp file in the same folder, then rename).
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {

@@ -35,6 +35,7 @@ pub mod image;
 pub mod io;
 #[cfg(test)]
 mod layers;
+pub mod limits;
 pub mod mesh;
 pub mod metric;
 pub(crate) mod prefetch;

@@ -105,12 +105,14 @@ pub fn render(job: &RenderJob) -> Result<RenderReport> {
             }
         }
         ViewSelection::Sheet { out } => {
+            let (n, side) = (cameras.len() as u64, job.settings.width as u64);
+            let columns = (n as f64).sqrt().ceil() as u64;
+            raster::check_sheet(n, columns, (side, job.settings.height as u64), 4)?;
             let frames = cameras
                 .iter()
                 .map(|c| renderer.render(c, &job.settings).map(|f| f.to_srgb8()))
                 .collect::<Result<Vec<_>>>()?;
-            let columns = (frames.len() as f32).sqrt().ceil() as u32;
-            let sheet = raster::contact_sheet(&frames, columns, 4, [32, 32, 32]);
+            let sheet = raster::contact_sheet(&frames, columns as u32, 4, [32, 32, 32])?;
             crate::io::write_image(out, &image::DynamicImage::ImageRgb8(sheet))?;
             written.push(out.clone());
         }

@@ -3,6 +3,7 @@
 //! once, here or beside its one command, as a `ValueEnum` or a `value_parser`.
 
 use clap::{Args, ValueEnum};
+use lodeval::limits::Bound;
 use lodeval::raster::{SamplePattern, Shading};
 use lodeval::scene::Rig;
 use lodeval::{Error, LoadOptions, MissingAssets};
@@ -83,9 +84,7 @@ impl LoadArgs {
 
 /// `--rig`: dodecahedron, icosahedron or fibonacci:N.
 pub(crate) fn parse_rig(text: &str) -> Result<Rig, String> {
-    Rig::parse(text).ok_or_else(|| {
-        format!("unknown rig '{text}': use dodecahedron, icosahedron or fibonacci:N")
-    })
+    Rig::parse(text)
 }
 
 /// `--shading`: one of the rasterizer's shading models.
@@ -110,4 +109,34 @@ pub(crate) fn parse_samples(text: &str) -> Result<u32, String> {
 /// The grid side of a count that [`parse_samples`] accepted.
 pub(crate) fn side(samples: u32) -> u32 {
     SamplePattern::side_for(samples).unwrap_or(1)
+}
+
+/// A clap value parser for a whole number within `bound` (a `lodeval::limits` bound), given as
+/// `T` (`u32`, `u64`, `usize`).
+pub(crate) fn count<T: TryFrom<u64>>(
+    bound: &'static Bound<u64>,
+) -> impl Fn(&str) -> Result<T, String> + Clone + Send + Sync + 'static {
+    move |text| {
+        let v: u64 = text
+            .trim()
+            .parse()
+            .map_err(|_| format!("'{text}' is not a whole number of {}", bound.unit))?;
+        if let Some(m) = bound.refuse(v) {
+            return Err(m);
+        }
+        T::try_from(v).map_err(|_| format!("{v} {} do not fit this platform", bound.unit))
+    }
+}
+
+/// A clap value parser for a number within `bound` (a `lodeval::limits` bound).
+pub(crate) fn value(
+    bound: &'static Bound<f64>,
+) -> impl Fn(&str) -> Result<f64, String> + Clone + Send + Sync + 'static {
+    move |text| {
+        let v: f64 = text
+            .trim()
+            .parse()
+            .map_err(|_| format!("'{text}' is not a number of {}", bound.unit))?;
+        bound.refuse(v).map_or(Ok(v), Err)
+    }
 }

@@ -6,7 +6,7 @@ use clap::{Args, ValueEnum};
 use lodeval::raster::Shading;
 use lodeval::{Error, LoadOptions};
 
-use super::args::{BackendArg, parse_samples, parse_shading};
+use super::args::{BackendArg, count, parse_samples, parse_shading};
 use super::print::{emit, emit_json};
 
 /// What `lodeval bench` measures.
@@ -38,7 +38,7 @@ pub(crate) struct BenchArgs {
     #[arg(long, default_value_t = 1400)]
     pub(crate) triangles: usize,
     /// For `optimize`: energy evaluations per timed run.
-    #[arg(long, default_value_t = 20_000)]
+    #[arg(long, default_value_t = 20_000, value_parser = count::<u64>(&lodeval::limits::EVALS))]
     pub(crate) evals: u64,
     /// For `simplify`: target ratios, comma separated.
     #[arg(long, value_delimiter = ',', default_value = "0.5,0.1,0.01")]
@@ -48,7 +48,7 @@ pub(crate) struct BenchArgs {
     pub(crate) bumpy: u32,
     /// For `metrics`: timed runs per metric; for `simplify`: timed runs per method and ratio
     /// (best and median reported); for `optimize`: timed optimizer runs per mesh.
-    #[arg(long, default_value_t = 5)]
+    #[arg(long, default_value_t = 5, value_parser = count::<usize>(&lodeval::limits::RUNS))]
     pub(crate) runs: usize,
     /// Torus rings (triangles = 2 · rings · sides).
     #[arg(long, default_value_t = 1000)]
@@ -57,10 +57,10 @@ pub(crate) struct BenchArgs {
     #[arg(long, default_value_t = 500)]
     pub(crate) sides: u32,
     /// Image edge in pixels.
-    #[arg(long, default_value_t = 1024)]
+    #[arg(long, default_value_t = 1024, value_parser = count::<u32>(&lodeval::limits::IMAGE_SIDE))]
     pub(crate) size: u32,
     /// Number of views (Fibonacci rig).
-    #[arg(long, default_value_t = 20)]
+    #[arg(long, default_value_t = 20, value_parser = count::<u32>(&lodeval::limits::VIEWS))]
     pub(crate) views: u32,
     /// Samples per pixel to measure, comma separated (squares: 1, 4, 9, ..., 64).
     #[arg(long, value_delimiter = ',', default_value = "1,4", value_parser = parse_samples)]
@@ -164,6 +164,10 @@ pub(crate) fn run(a: BenchArgs) -> Result<(), Error> {
     if a.what == BenchTarget::Simplify {
         let mut meshes = named_meshes(&a.images)?;
         if a.bumpy > 0 {
+            let triangles = 20u64.saturating_mul(4u64.saturating_pow(a.bumpy));
+            lodeval::limits::GENERATED_TRIANGLES
+                .check("the --bumpy sphere (20 × 4^N triangles):", triangles)
+                .map_err(Error::Usage)?;
             meshes.push((
                 format!("bumpy-sphere-s{}", a.bumpy),
                 lodeval::mesh::shapes::bumpy_sphere(a.bumpy),

@@ -6,7 +6,7 @@ use clap::{Args, ValueEnum};
 use lodeval::Error;
 use lodeval::app::DiffMetric;
 
-use super::args::BackendArg;
+use super::args::{BackendArg, value};
 use super::print::{emit, emit_json, warnings};
 
 /// `--metric`.
@@ -56,7 +56,8 @@ pub(crate) struct DiffArgs {
     #[arg(long, value_enum, default_value_t = MetricArg::Flip)]
     pub(crate) metric: MetricArg,
     /// Pixels per degree of visual angle (overrides the display flags).
-    #[arg(long, conflicts_with_all = ["display_width_m", "display_px", "distance_m"])]
+    #[arg(long, conflicts_with_all = ["display_width_m", "display_px", "distance_m"],
+          value_parser = value(&lodeval::limits::PPD))]
     pub(crate) ppd: Option<f64>,
     /// Display width in metres.
     #[arg(long, default_value_t = 0.7)]
@@ -92,21 +93,12 @@ pub(crate) struct DiffArgs {
 pub(crate) fn run(a: DiffArgs) -> Result<(), Error> {
     let metrics = a.metric.metrics();
     let viewing = match a.ppd {
-        Some(p) if p > 0.0 && p.is_finite() => lodeval::scene::Viewing::from_ppd(p),
-        Some(p) => {
-            return Err(Error::Usage(format!(
-                "--ppd {p}: must be a positive number"
-            )));
-        }
+        Some(p) => lodeval::scene::Viewing::from_ppd(p),
         None => {
-            if !(a.display_width_m > 0.0 && a.display_px > 0.0 && a.distance_m > 0.0) {
-                return Err(Error::Usage(
-                    "display width, pixels and distance must be positive".into(),
-                ));
-            }
             lodeval::scene::Viewing::from_display(a.display_width_m, a.display_px, a.distance_m)
         }
     };
+    viewing.check().map_err(Error::Usage)?;
     // With `all`, metrics that do not apply to this image size report a note instead.
     let lenient = a.metric == MetricArg::All;
     let engine = lodeval::backend::Engine::new(a.backend.into())?;

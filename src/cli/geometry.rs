@@ -14,7 +14,8 @@ pub(crate) struct GeometryArgs {
     /// The mesh compared with it.
     pub(crate) b: PathBuf,
     /// Face samples per mesh (every vertex is sampled too).
-    #[arg(long, default_value_t = 1_000_000)]
+    #[arg(long, default_value_t = 1_000_000,
+          value_parser = super::args::count::<usize>(&lodeval::limits::SURFACE_SAMPLES))]
     pub(crate) samples: usize,
     /// Print JSON.
     #[arg(long)]

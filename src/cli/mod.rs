@@ -29,8 +29,9 @@ use lodeval::Error;
     about = "Does a simplified mesh still look like the original, and from how far away can nobody tell them apart?"
 )]
 pub(crate) struct Cli {
-    /// Worker threads (default: all cores). Results are identical for any value.
-    #[arg(long, global = true, value_name = "N")]
+    /// Worker threads, 1 to 1024 (default: all cores). Results are identical for any value.
+    #[arg(long, global = true, value_name = "N",
+          value_parser = args::count::<usize>(&lodeval::limits::THREADS))]
     threads: Option<usize>,
     /// No progress output.
     #[arg(long, short, global = true)]
@@ -70,9 +71,6 @@ enum Command {
 /// Set up the worker threads and run the command.
 pub(crate) fn run(cli: Cli) -> Result<(), Error> {
     if let Some(n) = cli.threads {
-        if n == 0 {
-            return Err(Error::Usage("--threads must be at least 1".into()));
-        }
         rayon::ThreadPoolBuilder::new()
             .num_threads(n)
             .build_global()

@@ -6,6 +6,7 @@ use std::path::PathBuf;
 use clap::{Args, ValueEnum};
 use lodeval::Error;
 
+use super::args::count;
 use super::progress::Reporter;
 
 /// `--normals`.
@@ -32,13 +33,13 @@ pub(crate) struct OptimizeArgs {
     #[arg(long, conflicts_with_all = ["original", "simplified", "out"])]
     pub(crate) experiment: Option<PathBuf>,
     /// Budget in energy evaluations.
-    #[arg(long, default_value_t = 20_000)]
+    #[arg(long, default_value_t = 20_000, value_parser = count::<u64>(&lodeval::limits::EVALS))]
     pub(crate) evals: u64,
     /// Views while optimizing (20: dodecahedron, 12: icosahedron, else a Fibonacci sphere).
-    #[arg(long, default_value_t = 20)]
+    #[arg(long, default_value_t = 20, value_parser = count::<u32>(&lodeval::limits::VIEWS))]
     pub(crate) views: u32,
     /// Image edge in pixels.
-    #[arg(long, default_value_t = 256)]
+    #[arg(long, default_value_t = 256, value_parser = count::<u32>(&lodeval::limits::IMAGE_SIDE))]
     pub(crate) size: u32,
     /// Seed of the random edge choice.
     #[arg(long, default_value_t = 1)]

@@ -10,7 +10,7 @@ use lodeval::raster::{RenderSettings, Shading};
 use lodeval::scene::Rig;
 
 use super::args::{
-    BackendArg, LoadArgs, PatternArg, parse_rig, parse_samples, parse_shading, side,
+    BackendArg, LoadArgs, PatternArg, count, parse_rig, parse_samples, parse_shading, side,
 };
 use super::print::warnings;
 
@@ -22,7 +22,7 @@ pub(crate) struct RenderArgs {
     #[arg(short, long, required_unless_present = "all_views")]
     pub(crate) out: Option<PathBuf>,
     /// Image width and height in pixels.
-    #[arg(long, default_value_t = 512)]
+    #[arg(long, default_value_t = 512, value_parser = count::<u32>(&lodeval::limits::IMAGE_SIDE))]
     pub(crate) size: u32,
     /// View rig: dodecahedron (20 views), icosahedron (12) or fibonacci:N.
     #[arg(long, default_value = "dodecahedron", value_parser = parse_rig)]

@@ -10,7 +10,7 @@ use lodeval::scene::Rig;
 use lodeval::simplify::Method;
 use lodeval::simplify::williams::Criterion;
 
-use super::args::{parse_rig, parse_shading};
+use super::args::{count, parse_rig, parse_shading};
 use super::print::{emit, emit_json};
 use super::progress::Reporter;
 
@@ -112,7 +112,7 @@ pub(crate) struct SimplifyArgs {
     #[arg(long, value_enum, default_value_t = CriterionArg::Perceptual)]
     pub(crate) criterion: CriterionArg,
     /// williams: image size the views are rendered at (pixels).
-    #[arg(long, default_value_t = 512)]
+    #[arg(long, default_value_t = 512, value_parser = count::<u32>(&lodeval::limits::IMAGE_SIDE))]
     pub(crate) size: u32,
     /// Target ratio of the input's triangles.
     #[arg(long, conflicts_with_all = ["triangles", "error", "chain"])]
@@ -238,6 +238,11 @@ fn warn_short_of_goals(
 pub(crate) fn williams_job(a: &SimplifyArgs) -> Result<lodeval::app::WilliamsJob, Error> {
     use lodeval::app::WilliamsViews;
     let rig = a.rig.clone();
+    if let Some(c) = a.camera.iter().find(|c| !c.is_finite()) {
+        return Err(Error::Usage(format!(
+            "--camera {c}: every coordinate must be a finite number"
+        )));
+    }
     let views = match (a.camera.len(), a.all_views) {
         (0, true) => WilliamsViews::All(rig),
         (0, false) => WilliamsViews::One(rig, a.view.unwrap_or(0)),
@@ -269,12 +274,6 @@ pub(crate) fn williams_job(a: &SimplifyArgs) -> Result<lodeval::app::WilliamsJob
             ));
         }
     };
-    if a.size == 0 || a.size > 16384 {
-        return Err(Error::Usage(format!(
-            "--size {}: use 1..16384 pixels",
-            a.size
-        )));
-    }
     Ok(lodeval::app::WilliamsJob {
         mesh: a.mesh.clone().expect("clap requires it"),
         out: a.out.clone().expect("clap requires it"),

@@ -523,9 +523,7 @@ pub struct RigName(pub Rig);
 impl TryFrom<String> for RigName {
     type Error = String;
     fn try_from(s: String) -> std::result::Result<Self, String> {
-        Rig::parse(&s).map(RigName).ok_or_else(|| {
-            format!("unknown rig '{s}': use dodecahedron, icosahedron or fibonacci:N")
-        })
+        Rig::parse(&s).map(RigName)
     }
 }
 
@@ -623,6 +621,50 @@ impl Config {
                 format!("[viewing] {e}"),
                 "set black_cd_m2 below peak_cd_m2 (an office monitor: 0.5 and 100)",
             ));
+        }
+        if let Err(problem) = v.viewing().check() {
+            return Err(fail(
+                if v.ppd.is_some() { "ppd" } else { "[viewing]" },
+                format!("[viewing] {problem}"),
+                "describe a real display and viewer, or set ppd (the default display gives 67)",
+            ));
+        }
+        let counts = [
+            (
+                "geometry_samples",
+                self.geometry_samples,
+                &crate::limits::SURFACE_SAMPLES,
+            ),
+            (
+                "sheet_views",
+                self.images.sheet_views,
+                &crate::limits::SHEET_VIEWS,
+            ),
+            (
+                "views",
+                self.distance.views.unwrap_or(1),
+                &crate::limits::VIEWS,
+            ),
+        ];
+        for (key, value, bound) in counts {
+            if let Err(problem) = bound.check(key, value as u64) {
+                return Err(fail(
+                    key,
+                    problem,
+                    "see configs/README.md for the key's range",
+                ));
+            }
+        }
+        if self.images.contact_sheets {
+            let views = self.render.rig.0.count().min(self.images.sheet_views) as u64;
+            let side = self.render.size.0 as u64;
+            crate::raster::check_sheet(3 * views, 3, (side, side), 4).map_err(|e| {
+                fail(
+                    "sheet_views",
+                    format!("[images] {e}"),
+                    "lower sheet_views or [render] size, or set contact_sheets = false",
+                )
+            })?;
         }
         if self.metrics.is_empty() {
             return Err(fail(

@@ -123,13 +123,12 @@ pub fn merge(dirs: &[PathBuf], out: &Path) -> Result<Outcome> {
     let mut manifests = Vec::new();
     for d in dirs {
         let path = d.join("shard.json");
-        let text = std::fs::read_to_string(&path).map_err(|e| {
-            Error::input(
-                &path,
-                format!("cannot read: {e}"),
-                "give folders written by `lodeval eval --shard`",
-            )
-        })?;
+        let text = crate::io::read_input_text(
+            &path,
+            "shard manifest",
+            crate::limits::CONFIG_BYTES,
+            "give folders written by `lodeval eval --shard`",
+        )?;
         let m: Manifest = serde_json::from_str(&text).map_err(|e| {
             Error::input(
                 &path,

@@ -108,13 +108,12 @@ pub fn case_id(asset: &str, lod: &str) -> String {
 impl Plan {
     /// Parse and expand a config file.
     pub fn load(config_path: &Path) -> Result<Plan> {
-        let text = std::fs::read_to_string(config_path).map_err(|e| {
-            Error::input(
-                config_path,
-                format!("cannot read the config: {e}"),
-                "check the path",
-            )
-        })?;
+        let text = crate::io::read_input_text(
+            config_path,
+            "config",
+            crate::limits::CONFIG_BYTES,
+            "check the path",
+        )?;
         Plan::from_text(text, config_path)
     }
 

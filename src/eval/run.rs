@@ -213,7 +213,7 @@ pub fn run(plan: Plan, options: &RunOptions, progress: &dyn Progress) -> Result<
                         tiles.extend(t.iter().cloned());
                     }
                 }
-                let sheet = raster::contact_sheet(&tiles, 3, 4, [32, 32, 32]);
+                let sheet = raster::contact_sheet(&tiles, 3, 4, [32, 32, 32])?;
                 crate::io::write_image(
                     &out_dir
                         .join("sheets")

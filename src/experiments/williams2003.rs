@@ -180,10 +180,10 @@ pub fn load(config: &Path) -> Result<Experiment> {
             ));
         }
     }
-    if Rig::parse(&exp.rig).is_none() {
+    if let Err(problem) = Rig::parse(&exp.rig) {
         return Err(Error::input(
             config,
-            format!("unknown rig {}", exp.rig),
+            problem,
             "use dodecahedron, icosahedron or fibonacci:N",
         ));
     }
@@ -370,7 +370,7 @@ pub fn run(config: &Path, log: &mut dyn FnMut(&str)) -> Result<Vec<SummaryRow>> 
                 }
             })
             .collect();
-        let sheet = raster::contact_sheet(&images, images.len() as u32, 4, [255; 3]);
+        let sheet = raster::contact_sheet(&images, images.len() as u32, 4, [255; 3])?;
         crate::io::write_image(
             &out.join(format!("{}-sheet.png", spec.name)),
             &image::DynamicImage::ImageRgb8(sheet),

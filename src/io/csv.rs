@@ -30,34 +30,12 @@ pub fn write_rows<T: Serialize>(path: &Path, header: Option<&[&str]>, rows: &[T]
     super::write_atomic(path, &bytes)
 }
 
-/// The largest table [`read_rows`] reads (4 GiB: a nightly `metrics.csv` is tens of megabytes).
-pub const MAX_TABLE_BYTES: u64 = 4 << 30;
-
 /// Read a CSV with a header into rows; `fix` tells the user what file was expected. Only a
-/// regular file of at most [`MAX_TABLE_BYTES`] is read.
+/// regular file of at most [`crate::limits::TABLE_BYTES`] is read.
 pub fn read_rows<T: for<'de> Deserialize<'de>>(path: &Path, fix: &str) -> Result<Vec<T>> {
     // Only a regular file of bounded size: a folder, a FIFO or /dev/zero would block or read
     // without end.
-    match std::fs::metadata(path) {
-        Ok(m) if !m.is_file() => {
-            return Err(Error::input(
-                path,
-                "is not a regular file (a folder, a device or a pipe), so it cannot be a table",
-                fix,
-            ));
-        }
-        Ok(m) if m.len() > MAX_TABLE_BYTES => {
-            return Err(Error::input(
-                path,
-                format!(
-                    "is {} bytes, over the limit of {MAX_TABLE_BYTES} bytes for a table",
-                    m.len()
-                ),
-                fix,
-            ));
-        }
-        _ => {}
-    }
+    super::check_input(path, "table", crate::limits::TABLE_BYTES, fix)?;
     let mut r = ::csv::Reader::from_path(path)
         .map_err(|e| Error::input(path, format!("cannot read: {e}"), fix))?;
     r.deserialize()

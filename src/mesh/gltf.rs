@@ -22,7 +22,7 @@ use super::texture::{ColorSpace, Texture};
 use super::{Format, LoadOptions, Material, MeshData, MissingAssets, Source, read_file};
 use crate::error::{Error, Location, Result};
 
-const REEXPORT: &str =
+pub(super) const REEXPORT: &str =
     "re-export the glTF file (e.g. from Blender) or check it with the Khronos glTF validator";
 
 /// Accumulates primitives into one indexed mesh.
@@ -87,6 +87,22 @@ fn mean_channels(rgba: &[u8]) -> [f32; 3] {
     sum.map(|s| (s as f64 / n) as f32)
 }
 
+/// An external image must be a regular file within [`crate::limits::IMAGE_BYTES`] before the
+/// `gltf` crate reads it (a FIFO or `/dev/zero` would block or read without end).
+fn check_image_uri(base: &Path, source: gltf::image::Source) -> std::result::Result<(), String> {
+    match source {
+        gltf::image::Source::Uri { uri, .. } if !uri.starts_with("data:") && !uri.contains('%') => {
+            crate::io::check_input(&base.join(uri), "image", crate::limits::IMAGE_BYTES, "")
+                .map(|_| ())
+                .map_err(|e| match e {
+                    Error::Input { problem, .. } => problem,
+                    other => other.to_string(),
+                })
+        }
+        _ => Ok(()),
+    }
+}
+
 /// Load a glTF or GLB file.
 pub(crate) fn load(path: &Path, options: &LoadOptions) -> Result<MeshData> {
     let bytes = read_file(path)?;
@@ -95,19 +111,37 @@ pub(crate) fn load(path: &Path, options: &LoadOptions) -> Result<MeshData> {
     let gltf::Gltf { document, blob } =
         gltf::Gltf::from_slice_without_validation(&bytes).map_err(invalid)?;
     let root = document.into_json();
+    // Wrong accessor types first: they say more than the byte ranges they make wrong.
     check_primitive_accessors(path, &root)?;
+    super::gltf_check::check(path, &root)?;
     let document = gltf::Document::from_json(root).map_err(invalid)?;
     let base = path.parent().unwrap_or(Path::new("."));
     // Name a missing external buffer ourselves; the import error would only say "not found".
     for buffer in document.buffers() {
         if let gltf::buffer::Source::Uri(uri) = buffer.source() {
             let file = base.join(uri);
-            if !uri.starts_with("data:") && !uri.contains('%') && !file.is_file() {
+            if uri.starts_with("data:") || uri.contains('%') {
+                continue;
+            }
+            let element = Location::Element(format!("buffer {}", buffer.index()));
+            let fix = "put the .bin file next to the .gltf, or re-export as a single .glb";
+            if !file.exists() {
                 return Err(Error::input_at(
                     path,
-                    Location::Element(format!("buffer {}", buffer.index())),
+                    element,
                     format!("its data file '{uri}' is missing"),
-                    "put the .bin file next to the .gltf, or re-export as a single .glb",
+                    fix,
+                ));
+            }
+            // A FIFO or /dev/zero named as a buffer would block or read without end.
+            if let Err(Error::Input { problem, .. }) =
+                crate::io::check_input(&file, "buffer", crate::limits::MESH_BYTES, fix)
+            {
+                return Err(Error::input_at(
+                    path,
+                    element,
+                    format!("'{uri}': {problem}"),
+                    fix,
                 ));
             }
         }
@@ -136,14 +170,12 @@ pub(crate) fn load(path: &Path, options: &LoadOptions) -> Result<MeshData> {
         // Blinn–Phong material has one specular colour and exponent, so the texture's mean is used.
         let (mut metallic, mut roughness) = (pbr.metallic_factor(), pbr.roughness_factor());
         if let Some(info) = pbr.metallic_roughness_texture() {
-            let mean = gltf::image::Data::from_source(
-                info.texture().source().source(),
-                Some(base),
-                &buffers,
-            )
-            .ok()
-            .and_then(|d| rgba8_from(d).ok())
-            .map(|(_, _, px)| mean_channels(&px));
+            let source = info.texture().source().source();
+            let mean = check_image_uri(base, source.clone())
+                .ok()
+                .and_then(|()| gltf::image::Data::from_source(source, Some(base), &buffers).ok())
+                .and_then(|d| rgba8_from(d).ok())
+                .map(|(_, _, px)| mean_channels(&px));
             match mean {
                 Some([_, g, b]) => {
                     roughness *= g;
@@ -190,8 +222,11 @@ pub(crate) fn load(path: &Path, options: &LoadOptions) -> Result<MeshData> {
                         }
                         _ => format!("{} image {}", path.display(), image.index()),
                     };
-                    gltf::image::Data::from_source(image.source(), Some(base), &buffers)
-                        .map_err(|e| e.to_string())
+                    check_image_uri(base, image.source())
+                        .and_then(|()| {
+                            gltf::image::Data::from_source(image.source(), Some(base), &buffers)
+                                .map_err(|e| e.to_string())
+                        })
                         .and_then(rgba8_from)
                         .and_then(|(w, h, px)| {
                             Texture::new(label.clone(), w, h, px, space)

@@ -24,6 +24,7 @@
 mod bounds;
 pub mod edit;
 mod gltf;
+mod gltf_check;
 mod incidence;
 mod normals;
 mod obj;
@@ -421,11 +422,10 @@ pub fn load_unguarded(path: &Path, options: &LoadOptions) -> Result<Mesh> {
 
 /// Read a whole file, mapping I/O failures to an input error naming it.
 pub(crate) fn read_file(path: &Path) -> Result<Vec<u8>> {
-    std::fs::read(path).map_err(|e| {
-        Error::input(
-            path,
-            format!("cannot read the file: {e}"),
-            "check that it exists and is readable",
-        )
-    })
+    crate::io::read_input(
+        path,
+        "mesh",
+        crate::limits::MESH_BYTES,
+        "check that it exists and is a readable mesh file",
+    )
 }

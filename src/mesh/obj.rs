@@ -320,7 +320,13 @@ fn decode(path: &Path, bytes: Vec<u8>) -> Result<String> {
 /// Check the numeric statements of an MTL file with line numbers. `tobj` reports these only by
 /// kind, and panics on a colour with fewer than three numbers (found by the fuzz tests).
 fn check_mtl(path: &Path) -> Result<()> {
-    let text = String::from_utf8_lossy(&read_file(path)?).into_owned();
+    let bytes = crate::io::read_input(
+        path,
+        "material library",
+        crate::limits::MESH_BYTES,
+        "give a .mtl text file",
+    )?;
+    let text = String::from_utf8_lossy(&bytes).into_owned();
     for (i, line) in text.split('\n').enumerate() {
         let mut tokens = line.split_whitespace();
         let (count, what) = match tokens.next() {
@@ -378,7 +384,7 @@ pub(crate) fn load(path: &Path, options: &LoadOptions) -> Result<MeshData> {
     let mut mtl_paths: HashMap<String, PathBuf> = HashMap::new();
     for (line_no, name) in &scan.mtllibs {
         let resolved = resolve_asset_path(&dir, name);
-        if !resolved.is_file() {
+        if !resolved.exists() {
             let problem = format!(
                 "material library '{name}' not found at {}",
                 resolved.display()
@@ -391,7 +397,7 @@ pub(crate) fn load(path: &Path, options: &LoadOptions) -> Result<MeshData> {
                 "put the .mtl file there, fix the mtllib line, or pass --missing-assets warn to use default materials",
             )?;
         }
-        if resolved.is_file() {
+        if resolved.exists() {
             check_mtl(&resolved)?;
         }
         mtl_paths.insert(name.clone(), resolved);

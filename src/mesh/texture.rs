@@ -122,12 +122,20 @@ impl TextureCache {
         if let Some(t) = self.decoded.get(&key) {
             return Ok(t.clone());
         }
-        let bytes = std::fs::read(path).map_err(|e| {
-            Error::input(
+        // The error names the file that referred to the texture, and the texture in its text.
+        let bytes = crate::io::read_input(
+            path,
+            "texture",
+            crate::limits::IMAGE_BYTES,
+            "put the image there, fix the path in the file, or pass --missing-assets warn to render with the base colour",
+        )
+        .map_err(|e| match e {
+            Error::Input { problem, fix, .. } => Error::input(
                 referrer,
-                format!("texture '{}' cannot be read: {e}", path.display()),
-                "put the image there, fix the path in the file, or pass --missing-assets warn to render with the base colour",
-            )
+                format!("texture '{}': {problem}", path.display()),
+                fix,
+            ),
+            other => other,
         })?;
         let tex = Texture::decode(&path.display().to_string(), &bytes, space).map_err(|e| {
             Error::input(

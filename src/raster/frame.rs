@@ -4,6 +4,7 @@
 use glam::Vec3;
 
 use crate::color::linear_to_srgb;
+use crate::error::{Error, Result};
 
 /// Triangle id of a pixel no triangle covers.
 pub const NO_TRIANGLE: u32 = u32::MAX;
@@ -84,22 +85,44 @@ impl Frame {
     }
 }
 
+/// The pixel size (width, height) of a contact sheet of `count` tiles of `tile` pixels in a grid
+/// `columns` wide with `gap`-pixel borders, in 64 bits (no overflow for any `u32` inputs).
+pub fn sheet_dimensions(count: u64, columns: u64, tile: (u64, u64), gap: u64) -> (u64, u64) {
+    let columns = columns.max(1);
+    let rows = count.div_ceil(columns).max(1);
+    (columns * (tile.0 + gap) + gap, rows * (tile.1 + gap) + gap)
+}
+
+/// `Ok` when a contact sheet of that layout stays within [`crate::limits::SHEET_PIXELS`] (it is
+/// held in memory whole), else a usage error that names its size. Callers check before they
+/// render the tiles; [`contact_sheet`] checks again.
+pub fn check_sheet(count: u64, columns: u64, tile: (u64, u64), gap: u64) -> Result<()> {
+    let (w, h) = sheet_dimensions(count, columns, tile, gap);
+    match crate::limits::SHEET_PIXELS.refuse(w * h) {
+        None if w <= u32::MAX as u64 && h <= u32::MAX as u64 => Ok(()),
+        refusal => Err(Error::Usage(format!(
+            "a contact sheet of {count} images of {}x{} pixels would be {w}x{h} pixels: {}",
+            tile.0,
+            tile.1,
+            refusal.unwrap_or_else(|| "wider than an image can be".into())
+        ))),
+    }
+}
+
 /// Tile 8-bit images into a grid `columns` wide, in order, with a `gap`-pixel border of `bg`.
-/// All images must have the same size.
+/// All images must have the same size; the sheet must pass [`check_sheet`].
 pub fn contact_sheet(
     images: &[image::RgbImage],
     columns: u32,
     gap: u32,
     bg: [u8; 3],
-) -> image::RgbImage {
+) -> Result<image::RgbImage> {
     let columns = columns.max(1);
     let (w, h) = images.first().map_or((1, 1), |i| i.dimensions());
-    let rows = (images.len() as u32).div_ceil(columns).max(1);
-    let mut sheet = image::RgbImage::from_pixel(
-        columns * (w + gap) + gap,
-        rows * (h + gap) + gap,
-        image::Rgb(bg),
-    );
+    let count = images.len() as u64;
+    check_sheet(count, columns as u64, (w as u64, h as u64), gap as u64)?;
+    let (sw, sh) = sheet_dimensions(count, columns as u64, (w as u64, h as u64), gap as u64);
+    let mut sheet = image::RgbImage::from_pixel(sw as u32, sh as u32, image::Rgb(bg));
     for (k, img) in images.iter().enumerate() {
         let (c, r) = (k as u32 % columns, k as u32 / columns);
         image::imageops::replace(
@@ -109,7 +132,7 @@ pub fn contact_sheet(
             (gap + r * (h + gap)) as i64,
         );
     }
-    sheet
+    Ok(sheet)
 }
 
 impl From<&Frame> for crate::image::LinearImage {

@@ -41,7 +41,7 @@ use rayon::prelude::*;
 use crate::error::{Error, Result};
 use crate::scene::{Camera, Projection};
 
-pub use frame::{Frame, NO_TRIANGLE, contact_sheet};
+pub use frame::{Frame, NO_TRIANGLE, check_sheet, contact_sheet, sheet_dimensions};
 pub use prepare::PreparedMesh;
 pub use scene::RenderScene;
 #[cfg(feature = "gpu")]
@@ -180,8 +180,8 @@ impl RenderSettings {
         shading: Shading::Gouraud,
         cull_backfaces: false,
     };
-    /// Largest accepted image edge, pixels.
-    pub const MAX_SIZE: u32 = 16384;
+    /// Largest accepted image edge, pixels ([`crate::limits::IMAGE_SIDE`]).
+    pub const MAX_SIZE: u32 = crate::limits::IMAGE_SIDE.max as u32;
 
     pub(crate) fn check(&self) -> Result<()> {
         if self.width == 0

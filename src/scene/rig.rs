@@ -119,14 +119,29 @@ impl Rig {
         dirs.into_iter().map(|d| d.normalize_or(Vec3::Z)).collect()
     }
 
-    /// Parse `dodecahedron`, `icosahedron` or `fibonacci:N`.
-    pub fn parse(text: &str) -> Option<Rig> {
+    /// The number of views, without building them.
+    pub fn count(&self) -> usize {
+        match self {
+            Rig::Dodecahedron => 20,
+            Rig::Icosahedron => 12,
+            Rig::Fibonacci(n) => (*n).max(1) as usize,
+            Rig::Explicit(v) => v.len(),
+        }
+    }
+
+    /// Parse `dodecahedron`, `icosahedron` or `fibonacci:N` (N within
+    /// [`crate::limits::VIEWS`]); the error is the message for the user.
+    pub fn parse(text: &str) -> Result<Rig, String> {
+        let unknown =
+            || format!("unknown rig '{text}': use dodecahedron, icosahedron or fibonacci:N");
         match text {
-            "dodecahedron" => Some(Rig::Dodecahedron),
-            "icosahedron" => Some(Rig::Icosahedron),
+            "dodecahedron" => Ok(Rig::Dodecahedron),
+            "icosahedron" => Ok(Rig::Icosahedron),
             _ => {
-                let n: u32 = text.strip_prefix("fibonacci:")?.parse().ok()?;
-                (n >= 1).then_some(Rig::Fibonacci(n))
+                let n = text.strip_prefix("fibonacci:").ok_or_else(unknown)?;
+                let n: u64 = n.trim().parse().map_err(|_| unknown())?;
+                let n = crate::limits::VIEWS.check("fibonacci:", n)?;
+                Ok(Rig::Fibonacci(n as u32))
             }
         }
     }
@@ -166,7 +181,20 @@ mod tests {
         let d = Rig::parse("fibonacci:50").unwrap().directions();
         assert_eq!(d.len(), 50);
         assert!(d.iter().all(|v| (v.length() - 1.0).abs() < 1e-6));
-        assert_eq!(Rig::parse("fibonacci:0"), None);
-        assert_eq!(Rig::parse("cube"), None);
+        assert!(
+            Rig::parse("fibonacci:0")
+                .unwrap_err()
+                .contains("limits of 1 to 10000")
+        );
+        let huge = Rig::parse("fibonacci:4000000000").unwrap_err();
+        assert!(huge.contains("fibonacci: 4000000000"), "{huge}");
+        for rig in [Rig::Dodecahedron, Rig::Icosahedron, Rig::Fibonacci(7)] {
+            assert_eq!(rig.count(), rig.directions().len());
+        }
+        assert!(
+            Rig::parse("cube")
+                .unwrap_err()
+                .contains("unknown rig 'cube'")
+        );
     }
 }

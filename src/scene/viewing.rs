@@ -53,6 +53,40 @@ impl Viewing {
                 / 180.0,
         )
     }
+
+    /// `Ok` when every field is a finite number above 0 and the pixels per degree they give lie
+    /// within [`crate::limits::PPD`]; else the message (the metrics' filters are sized by it, so
+    /// 1e-30 gave NaN scores and 1e30 an allocation that aborted).
+    pub fn check(&self) -> Result<(), String> {
+        let fields = [
+            ("display width", self.display_width_m, "m"),
+            ("display pixels", self.display_px, "px"),
+            ("viewing distance", self.distance_m, "m"),
+        ];
+        if self.ppd_override.is_none() {
+            for (name, v, unit) in fields {
+                if !(v.is_finite() && v > 0.0) {
+                    return Err(format!(
+                        "the {name} {v} {unit} is not a finite number above 0"
+                    ));
+                }
+            }
+        }
+        use crate::limits::{PPD, Quantity};
+        let ppd = self.ppd();
+        match PPD.refuse(ppd) {
+            None => Ok(()),
+            Some(m) if self.ppd_override.is_some() => Err(format!("pixels per degree {m}")),
+            Some(_) => Err(format!(
+                "the display ({} m wide, {} px, seen from {} m) gives {} pixels per degree, {}",
+                self.display_width_m.show(),
+                self.display_px.show(),
+                self.distance_m.show(),
+                ppd.show(),
+                PPD.outside()
+            )),
+        }
+    }
 }
 
 impl Default for Viewing {

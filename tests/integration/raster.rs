@@ -262,9 +262,9 @@ fn render_cli_writes_pngs_and_rejects_bad_requests() {
     assert_eq!(r.code, 0, "{}", r.stderr);
     assert_eq!(std::fs::read_dir(&views).unwrap().count(), 5);
     for (args, expect) in [
-        (vec!["--size", "0"], "image size 0x0"),
-        // Past the 16-bit pixel boxes of the set-up records (setup.rs).
-        (vec!["--size", "16385"], "image size 16385x16385"),
+        (vec!["--size", "0"], "'0' for '--size"),
+        // Past the 16-bit pixel boxes of the set-up records (setup.rs): src/limits.rs.
+        (vec!["--size", "16385"], "'16385' for '--size"),
         // Flag values clap parses: the message names the flag and the value.
         (vec!["--rig", "cube"], "'cube' for '--rig"),
         (vec!["--shading", "toon"], "'toon' for '--shading"),

@@ -56,6 +56,13 @@ pub struct RasterBenchRow {
 /// Render a procedural torus from every view and time it. Timing is for reporting only: nothing
 /// asserts on it.
 pub fn bench_raster(b: &RasterBench) -> Result<Vec<RasterBenchRow>> {
+    let triangles = 2 * b.rings.max(3) as u64 * b.sides.max(3) as u64;
+    crate::limits::GENERATED_TRIANGLES
+        .check("the benchmark torus (2 × rings × sides):", triangles)
+        .map_err(Error::Usage)?;
+    crate::limits::VIEWS
+        .check("--views", b.views as u64)
+        .map_err(Error::Usage)?;
     let mesh = Arc::new(crate::mesh::shapes::torus(b.rings, b.sides, 0.35));
     let scene = RenderScene::of(mesh.clone());
     let cameras = Rig::Fibonacci(b.views).cameras(&mesh, 1.0);

@@ -78,11 +78,8 @@ impl Condition {
 
     /// Refuse conditions that make no sense (usage error naming the value).
     pub fn check(&self) -> Result<()> {
-        if !self.ppd.is_finite() || self.ppd <= 0.0 || self.ppd > 1e4 {
-            return Err(Error::Usage(format!(
-                "--ppd {}: give pixels per degree between 0 and 10000 (ModelFest's is 120)",
-                self.ppd
-            )));
+        if let Err(m) = crate::limits::PPD.check("--ppd", self.ppd) {
+            return Err(Error::Usage(format!("{m}; ModelFest's is 120")));
         }
         if !self.background_cd_m2.is_finite()
             || self.background_cd_m2 <= 0.0
@@ -134,26 +131,7 @@ pub struct Calibration {
 fn read_small(path: &Path, what: &str) -> Result<Vec<u8>> {
     let fix = "regenerate the folder with reference/oracles/modelfest/make_modelfest.py, or pass \
                --data with the folder that holds it";
-    let meta = std::fs::metadata(path)
-        .map_err(|e| Error::input(path, format!("cannot read the {what}: {e}"), fix))?;
-    if !meta.is_file() {
-        return Err(Error::input(
-            path,
-            format!("the {what} is not a regular file"),
-            fix,
-        ));
-    }
-    if meta.len() > MAX_FILE_BYTES {
-        return Err(Error::input(
-            path,
-            format!(
-                "the {what} is {} bytes, more than the {MAX_FILE_BYTES} a ModelFest file can need",
-                meta.len()
-            ),
-            fix,
-        ));
-    }
-    std::fs::read(path).map_err(|e| Error::input(path, format!("cannot read the {what}: {e}"), fix))
+    crate::io::read_input(path, what, MAX_FILE_BYTES, fix)
 }
 
 impl ModelFest {

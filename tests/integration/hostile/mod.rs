@@ -8,10 +8,20 @@
 //!   without distances, more `switch_m` values than LODs), refused before the first render.
 //! - `baseline`: gate baselines that hold nothing usable (empty, a header only, prose, a folder,
 //!   `/dev/zero`, another config's assets, NaN), refused; a LOD the baseline lacks fails the gate.
+//! - `bounds`: sizes, counts and values far out of range (threads, views, pixels per degree,
+//!   samples, benchmark meshes, contact sheets), refused with the bound of `src/limits.rs`.
+//! - `gltf`: glTF structure the parser accepts but nothing can read through (a node cycle, which
+//!   used to hang with growing memory; two parents; accessors and views past their ends).
+//! - `files`: paths that are not regular files (a FIFO, `/dev/zero`, `/dev/urandom`, a symlink
+//!   to one, a folder) as a mesh, material library, texture, glTF buffer or image, image or
+//!   config, which used to block or read until memory ran out.
 //! - `obj_text`: OBJ text that loaded wrong (a byte-order mark, `usemtl` of an undefined
 //!   material) or not at all (Latin-1 in a comment).
 
 mod baseline;
+mod bounds;
+mod files;
+mod gltf;
 mod goals;
 mod obj_text;
 mod plan;

@@ -1,0 +1,220 @@
+//! Every bound on a size, count or value a user can give lodeval, on the command line or in a
+//! config, in one place with the reason for each. A value outside its bound is refused with a
+//! message naming the flag or key, the bound and why it exists; nothing is clamped silently.
+//! README.md's "Limits" table lists the same bounds, and a test keeps the two in step.
+//!
+//! Decisions:
+//! - Bounds are set where memory or time would otherwise grow without end, or where the
+//!   computation stops meaning anything (a pixel wider than a degree of visual angle), and
+//!   generously above what any real job needs, so they never get in a real job's way.
+//! - Sizes of files read are bounds too (an input is read only up to what its format can need,
+//!   so `/dev/zero` under a mesh's name cannot exhaust memory).
+
+/// A number a bound is about, printed briefly (1e30, not thirty zeros).
+pub trait Quantity: PartialOrd + Copy {
+    /// The value as a person reads it.
+    fn show(self) -> String;
+}
+
+impl Quantity for u64 {
+    fn show(self) -> String {
+        self.to_string()
+    }
+}
+
+impl Quantity for f64 {
+    fn show(self) -> String {
+        let a = self.abs();
+        if a != 0.0 && !(1e-3..1e7).contains(&a) {
+            format!("{self:e}")
+        } else {
+            self.to_string()
+        }
+    }
+}
+
+/// An inclusive range of allowed values with the words a message needs.
+///
+/// # Guarantees
+/// `min ≤ max`, both finite (the constants below are the only instances).
+#[derive(Debug, Clone, Copy)]
+pub struct Bound<T> {
+    /// Smallest allowed value.
+    pub min: T,
+    /// Largest allowed value.
+    pub max: T,
+    /// What is counted or measured ("worker threads", "pixels per degree").
+    pub unit: &'static str,
+    /// Why the bound is there, for the message.
+    pub why: &'static str,
+}
+
+impl<T: Quantity> Bound<T> {
+    /// Whether `v` lies within the bound (a NaN does not).
+    pub fn contains(&self, v: T) -> bool {
+        self.min <= v && v <= self.max
+    }
+
+    /// `Ok(v)` within the bound, else a message naming `what` (a flag or a config key), the
+    /// value, the bound and the reason.
+    pub fn check(&self, what: &str, v: T) -> Result<T, String> {
+        self.refuse(v).map_or(Ok(v), |m| Err(format!("{what} {m}")))
+    }
+
+    /// `None` within the bound, else "V is outside lodeval's limits of MIN to MAX UNIT (WHY)".
+    pub fn refuse(&self, v: T) -> Option<String> {
+        (!self.contains(v)).then(|| format!("{} is {}", v.show(), self.outside()))
+    }
+
+    /// "outside lodeval's limits of MIN to MAX UNIT (WHY)".
+    pub fn outside(&self) -> String {
+        format!(
+            "outside lodeval's limits of {} to {} {} ({})",
+            self.min.show(),
+            self.max.show(),
+            self.unit,
+            self.why
+        )
+    }
+}
+
+/// Worker threads (`--threads`). Starting threads costs time that grows faster than their
+/// number (1 024 take 1.5 s to start on the 2-core reference machine, 4 000 took 22 s), and no
+/// machine lodeval runs on has more cores than this.
+pub const THREADS: Bound<u64> = Bound {
+    min: 1,
+    max: 1024,
+    unit: "worker threads",
+    why: "more threads than cores only cost start-up time",
+};
+
+/// Views of a rig (`fibonacci:N`, `--views`): each view is rendered and scored, and the views'
+/// cameras and scores are held at once.
+pub const VIEWS: Bound<u64> = Bound {
+    min: 1,
+    max: 10_000,
+    unit: "views",
+    why: "10 000 views already sample the sphere every 2 degrees",
+};
+
+/// Image edge in pixels (`--size`, `[render] size`, `max_diameter_px`): a 16 384² frame with its
+/// depth and sample buffers takes several GiB.
+pub const IMAGE_SIDE: Bound<u64> = Bound {
+    min: 1,
+    max: 16_384,
+    unit: "pixels",
+    why: "a 16 384² frame and its buffers already take several GiB",
+};
+
+/// Pixels per degree of visual angle (`--ppd`, `[viewing] ppd`, and the value the display
+/// geometry gives). Below 1 a pixel is wider than a degree and the metrics' filters have no
+/// pixels to act on; above 1 000 a pixel is 17 times finer than the eye resolves, and the
+/// filter kernels (which grow with it) take the memory.
+pub const PPD: Bound<f64> = Bound {
+    min: 1.0,
+    max: 1000.0,
+    unit: "pixels per degree",
+    why: "below 1 a pixel spans more than a degree; above 1 000 it is far finer than the eye resolves",
+};
+
+/// Face samples per mesh for the surface distances (`geometry --samples`,
+/// `geometry_samples`): 32 bytes of memory each, over both meshes.
+pub const SURFACE_SAMPLES: Bound<u64> = Bound {
+    min: 0,
+    max: 50_000_000,
+    unit: "face samples",
+    why: "50 million samples take 1.6 GiB and measure to about 0.01 % of the diagonal",
+};
+
+/// Views on one contact sheet (`sheet_views`).
+pub const SHEET_VIEWS: Bound<u64> = Bound {
+    min: 1,
+    max: 100,
+    unit: "views",
+    why: "a sheet is a picture for a person; use heat maps for more views",
+};
+
+/// Pixels of one contact sheet (three tiles across, one row per view): the sheet is held in
+/// memory as 8-bit RGBA before it is written.
+pub const SHEET_PIXELS: Bound<u64> = Bound {
+    min: 1,
+    max: 1 << 28,
+    unit: "pixels",
+    why: "a sheet of 268 million pixels takes 1 GiB; lower sheet_views or the image size",
+};
+
+/// Triangles of a generated benchmark mesh (`bench raster --rings × --sides × 2`,
+/// `bench simplify --bumpy`): vertices, indices and the prepared mesh are held at once.
+pub const GENERATED_TRIANGLES: Bound<u64> = Bound {
+    min: 1,
+    max: 100_000_000,
+    unit: "triangles",
+    why: "100 million triangles take about 10 GiB once prepared for rendering",
+};
+
+/// Energy evaluations of the image-driven optimizer (`--evals`): only time grows with it.
+pub const EVALS: Bound<u64> = Bound {
+    min: 1,
+    max: 10_000_000_000,
+    unit: "evaluations",
+    why: "ten billion evaluations take weeks",
+};
+
+/// Timed runs of a benchmark (`--runs`).
+pub const RUNS: Bound<u64> = Bound {
+    min: 1,
+    max: 1000,
+    unit: "runs",
+    why: "the median of 1 000 runs is as good as it gets",
+};
+
+/// Largest mesh file read (OBJ, MTL, PLY, OFF, glTF, GLB and glTF buffers), bytes.
+pub const MESH_BYTES: u64 = 4 << 30;
+/// Largest image file read (textures, `diff` and golden images), bytes.
+pub const IMAGE_BYTES: u64 = 1 << 30;
+/// Largest config or manifest read (TOML, JSON), bytes.
+pub const CONFIG_BYTES: u64 = 16 << 20;
+/// Largest CSV table read (a gate baseline, a shard's tables), bytes.
+pub const TABLE_BYTES: u64 = 4 << 30;
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn bounds_are_inclusive_and_refuse_nan() {
+        assert!(THREADS.contains(1) && THREADS.contains(1024));
+        assert!(!THREADS.contains(0) && !THREADS.contains(1025));
+        assert!(PPD.contains(1.0) && PPD.contains(1000.0));
+        assert!(!PPD.contains(f64::NAN) && !PPD.contains(1e-30) && !PPD.contains(1e30));
+        let e = THREADS.check("--threads", 100_000).unwrap_err();
+        assert!(
+            e.contains("--threads 100000") && e.contains("1 to 1024 worker threads"),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn every_bound_is_in_the_readme() {
+        // The README's "Limits" table must name every bound of this file with its maximum.
+        let readme = include_str!("../README.md");
+        let section = readme
+            .split("\n## Limits")
+            .nth(1)
+            .expect("README.md has a Limits section");
+        let section = section.split("\n## ").next().unwrap();
+        let code = include_str!("limits.rs");
+        let names: Vec<&str> = code
+            .lines()
+            .filter_map(|l| l.strip_prefix("pub const "))
+            .filter_map(|l| l.split(':').next())
+            .collect();
+        assert!(names.len() >= 13, "{names:?}");
+        for name in names {
+            assert!(
+                section.contains(&format!("`{name}`")),
+                "README's Limits section lacks `{name}`"
+            );
+        }
+    }
+}

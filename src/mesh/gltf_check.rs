@@ -1,0 +1,192 @@
+//! Structural checks of a glTF document before anything reads through it: the node hierarchy is
+//! a forest (glTF 2.0 §3.5.3: no cycles, at most one parent per node, scene roots are roots), and
+//! every accessor lies inside its buffer view and every buffer view inside its buffer (§3.6.2).
+//!
+//! The `gltf` crate checks that indices are in range but not these: a node that is its own
+//! descendant made the scene walk loop forever while memory grew, and an accessor past its view's
+//! end surfaced as "has no POSITION attribute". Each check names the node, accessor or buffer
+//! view at fault.
+
+use std::path::Path;
+
+use gltf::json::validation::Checked;
+
+use super::gltf::REEXPORT;
+use crate::error::{Error, Location, Result};
+
+/// Run every structural check on `root`.
+pub(super) fn check(path: &Path, root: &gltf::json::Root) -> Result<()> {
+    check_nodes(path, root)?;
+    check_views(path, root)?;
+    check_accessors(path, root)
+}
+
+fn at(path: &Path, element: String, problem: String) -> Error {
+    Error::input_at(path, Location::Element(element), problem, REEXPORT)
+}
+
+/// The node hierarchy must be a forest: in-range children, one parent at most, no cycles, and
+/// scenes list only root nodes.
+fn check_nodes(path: &Path, root: &gltf::json::Root) -> Result<()> {
+    let n = root.nodes.len();
+    let mut parent: Vec<Option<usize>> = vec![None; n];
+    for (i, node) in root.nodes.iter().enumerate() {
+        for child in node.children.iter().flatten() {
+            let c = child.value();
+            if c >= n {
+                return Err(at(
+                    path,
+                    format!("node {i}"),
+                    format!("lists child node {c}, but the file has {n} nodes"),
+                ));
+            }
+            if c == i {
+                return Err(at(
+                    path,
+                    format!("node {i}"),
+                    "is its own child, so the hierarchy has a cycle".into(),
+                ));
+            }
+            if let Some(p) = parent[c] {
+                return Err(at(
+                    path,
+                    format!("node {c}"),
+                    format!("is a child of both node {p} and node {i}; a glTF node has one parent"),
+                ));
+            }
+            parent[c] = Some(i);
+        }
+    }
+    // With one parent each, a cycle is a chain of parents that comes back to where it started;
+    // `state` marks nodes known to reach a root (2) and nodes on the chain being walked (1).
+    let mut state = vec![0u8; n];
+    for start in 0..n {
+        let mut chain = Vec::new();
+        let mut cur = Some(start);
+        while let Some(c) = cur {
+            match state[c] {
+                2 => break,
+                1 => {
+                    let cycle: Vec<String> = chain.iter().rev().map(usize::to_string).collect();
+                    return Err(at(
+                        path,
+                        format!("node {c}"),
+                        format!(
+                            "is its own ancestor (through nodes {}), so the hierarchy has a cycle",
+                            cycle.join(", ")
+                        ),
+                    ));
+                }
+                _ => {
+                    state[c] = 1;
+                    chain.push(c);
+                    cur = parent[c];
+                }
+            }
+        }
+        for c in chain {
+            state[c] = 2;
+        }
+    }
+    for (si, scene) in root.scenes.iter().enumerate() {
+        for node in &scene.nodes {
+            let r = node.value();
+            if r >= n {
+                return Err(at(
+                    path,
+                    format!("scene {si}"),
+                    format!("lists node {r}, but the file has {n} nodes"),
+                ));
+            }
+            if let Some(p) = parent[r] {
+                return Err(at(
+                    path,
+                    format!("scene {si}"),
+                    format!("lists node {r} as a root, but it is a child of node {p}"),
+                ));
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Every buffer view lies inside its buffer.
+fn check_views(path: &Path, root: &gltf::json::Root) -> Result<()> {
+    for (vi, view) in root.buffer_views.iter().enumerate() {
+        let b = view.buffer.value();
+        let Some(buffer) = root.buffers.get(b) else {
+            return Err(at(
+                path,
+                format!("buffer view {vi}"),
+                format!(
+                    "refers to buffer {b}, but the file has {} buffers",
+                    root.buffers.len()
+                ),
+            ));
+        };
+        let offset = view.byte_offset.map_or(0, |o| o.0);
+        let end = offset.checked_add(view.byte_length.0);
+        if end.is_none_or(|e| e > buffer.byte_length.0) {
+            return Err(at(
+                path,
+                format!("buffer view {vi}"),
+                format!(
+                    "spans bytes {offset}..{offset}+{}, past the end of buffer {b} ({} bytes)",
+                    view.byte_length.0, buffer.byte_length.0
+                ),
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// Every accessor's elements lie inside its buffer view (sparse accessors without a view are
+/// zeros plus substitutions and need no check here).
+fn check_accessors(path: &Path, root: &gltf::json::Root) -> Result<()> {
+    for (ai, acc) in root.accessors.iter().enumerate() {
+        let Some(view_index) = acc.buffer_view else {
+            continue;
+        };
+        let vi = view_index.value();
+        let Some(view) = root.buffer_views.get(vi) else {
+            return Err(at(
+                path,
+                format!("accessor {ai}"),
+                format!(
+                    "refers to buffer view {vi}, but the file has {} buffer views",
+                    root.buffer_views.len()
+                ),
+            ));
+        };
+        let (Checked::Valid(ty), Checked::Valid(ct)) = (&acc.type_, &acc.component_type) else {
+            continue; // the crate's validation names an unknown type
+        };
+        let element = (ty.multiplicity() * ct.0.size()) as u64;
+        let stride = view
+            .byte_stride
+            .map_or(element, |s| s.0 as u64)
+            .max(element);
+        let count = acc.count.0;
+        let offset = acc.byte_offset.map_or(0, |o| o.0);
+        let need = match count {
+            0 => Some(offset),
+            _ => (count - 1)
+                .checked_mul(stride)
+                .and_then(|s| s.checked_add(element))
+                .and_then(|s| s.checked_add(offset)),
+        };
+        if need.is_none_or(|e| e > view.byte_length.0) {
+            return Err(at(
+                path,
+                format!("accessor {ai}"),
+                format!(
+                    "needs {} bytes for {count} elements from offset {offset}, but buffer view \
+                     {vi} has {} bytes",
+                    need.map_or("more than 2^64".to_string(), |e| e.to_string()),
+                    view.byte_length.0
+                ),
+            ));
+        }
+    }
+    Ok(())
+}
