@@ -6,6 +6,7 @@
 //! becomes sRGB bytes on disk.
 
 pub mod csv;
+pub mod finite;
 pub mod label;
 pub mod plot;
 pub mod plot_png;

@@ -24,12 +24,37 @@ impl Quantity for u64 {
 
 impl Quantity for f64 {
     fn show(self) -> String {
-        let a = self.abs();
-        if a != 0.0 && !(1e-3..1e7).contains(&a) {
-            format!("{self:e}")
+        brief(self)
+    }
+}
+
+impl Quantity for f32 {
+    fn show(self) -> String {
+        brief(self as f64)
+    }
+}
+
+/// Six significant digits at most, trailing zeros dropped; scientific notation outside
+/// 1e-3 … 1e7 (`1e30`, `0.7`, `1.41421`, `1024`).
+fn brief(v: f64) -> String {
+    let a = v.abs();
+    if !v.is_finite() || a == 0.0 {
+        return v.to_string();
+    }
+    let trim = |t: String| {
+        if t.contains('.') {
+            t.trim_end_matches('0').trim_end_matches('.').to_string()
         } else {
-            self.to_string()
+            t
         }
+    };
+    if (1e-3..1e7).contains(&a) {
+        let decimals = (5 - a.log10().floor() as i32).max(0) as usize;
+        trim(format!("{v:.decimals$}"))
+    } else {
+        let t = format!("{v:.5e}");
+        let (mantissa, exponent) = t.split_once('e').unwrap_or((&t, "0"));
+        format!("{}e{exponent}", trim(mantissa.to_string()))
     }
 }
 
@@ -168,6 +193,25 @@ pub const RUNS: Bound<u64> = Bound {
     why: "the median of 1 000 runs is as good as it gets",
 };
 
+/// A mesh's size: its bounding-box diagonal in model units. Squared triangle areas (fourth
+/// powers of lengths) are formed in single precision, whose range is about 1e±38.
+pub const MESH_EXTENT: Bound<f64> = Bound {
+    min: 1e-6,
+    max: 1e9,
+    unit: "model units across",
+    why: "squared triangle areas, the fourth power of the size, must fit single precision",
+};
+
+/// How far a mesh may sit from the origin (its farthest coordinate), in multiples of its size.
+/// Positions are single precision: 1 024 sizes out they resolve the shape to 1/8 000 of its
+/// size, and much farther out vertices merge and renders break up.
+pub const MESH_OFFSET: Bound<f64> = Bound {
+    min: 0.0,
+    max: 1024.0,
+    unit: "times its size from the origin",
+    why: "single-precision positions farther out cannot hold the shape",
+};
+
 /// Largest mesh file read (OBJ, MTL, PLY, OFF, glTF, GLB and glTF buffers), bytes.
 pub const MESH_BYTES: u64 = 4 << 30;
 /// Largest image file read (textures, `diff` and golden images), bytes.
@@ -187,6 +231,13 @@ mod tests {
         assert!(!THREADS.contains(0) && !THREADS.contains(1025));
         assert!(PPD.contains(1.0) && PPD.contains(1000.0));
         assert!(!PPD.contains(f64::NAN) && !PPD.contains(1e-30) && !PPD.contains(1e30));
+        assert_eq!(1e30f64.show(), "1e30");
+        assert_eq!(1.7320508336e30f64.show(), "1.73205e30");
+        assert_eq!(0.7f64.show(), "0.7");
+        assert_eq!(0.1f32.show(), "0.1");
+        assert_eq!(1024f64.show(), "1024");
+        assert_eq!(5773503.27f64.show(), "5773503");
+        assert_eq!(1e-6f64.show(), "1e-6");
         let e = THREADS.check("--threads", 100_000).unwrap_err();
         assert!(
             e.contains("--threads 100000") && e.contains("1 to 1024 worker threads"),
@@ -209,7 +260,7 @@ mod tests {
             .filter_map(|l| l.strip_prefix("pub const "))
             .filter_map(|l| l.split(':').next())
             .collect();
-        assert!(names.len() >= 13, "{names:?}");
+        assert!(names.len() >= 15, "{names:?}");
         for name in names {
             assert!(
                 section.contains(&format!("`{name}`")),

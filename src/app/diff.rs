@@ -192,9 +192,7 @@ pub fn diff(
                 DiffMetric::Msssim => {
                     r.value = Some(ssim::ms_ssim(&a, &b, ssim::SsimInput::SrgbLuma)?)
                 }
-                DiffMetric::Psnr => {
-                    r.value = Some(engine.mse(&a, &b)?.psnr_db).filter(|v| v.is_finite())
-                }
+                DiffMetric::Psnr => r.value = Some(engine.mse(&a, &b)?.psnr_db),
                 DiffMetric::Mse => r.value = Some(engine.mse(&a, &b)?.mse),
                 DiffMetric::Vdp => {
                     let s = vdp.compare(&a, &b)?;

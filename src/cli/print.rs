@@ -7,6 +7,11 @@ use lodeval::Error;
 
 /// Write a value to stdout as pretty JSON with a trailing newline.
 pub(crate) fn emit_json<T: serde::Serialize>(value: &T) -> Result<(), Error> {
+    lodeval::io::finite::check(value).map_err(|field| {
+        Error::Internal(format!(
+            "the JSON output has {field}, which is not a finite number"
+        ))
+    })?;
     let json = serde_json::to_string_pretty(value).map_err(|e| Error::Internal(e.to_string()))?;
     emit(&(json + "\n"))
 }

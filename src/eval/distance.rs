@@ -17,7 +17,12 @@
 //! threshold). Each row also gives the VDP's probability and JND at the reported size. The
 //! search doubles the diameter from 4 px until the LOD becomes visible, then bisects on the
 //! logarithm of the diameter to 2 %; the smallest distance beyond which the LOD is imperceptible
-//! is the distance of the largest invisible diameter. Views: the `views` worst views of the full-size evaluation (by FLIP, else the first
+//! is the distance of the largest invisible diameter. A LOD with an engine switch distance
+//! (`switch_m`) has the range widened to take in its diameter there (down to 1 px, up to the
+//! display's height), so the gate's question — visible where the engine uses it? — has an answer.
+//! Where the search hits a limit the row says which bound it is (`DistanceBound`): visible even
+//! at the smallest size (imperceptible only farther than the distance given) or invisible up to
+//! the largest (imperceptible from the distance given at the latest). Views: the `views` worst views of the full-size evaluation (by FLIP, else the first
 //! metric), since the worst view decides.
 //!
 //! Engine parameters at that distance (all from the same sphere, so they agree with each other):
@@ -35,7 +40,7 @@ use std::collections::BTreeMap;
 use glam::Vec3;
 
 use super::config::{DistanceConfig, ViewingConfig};
-use super::tables::{DistanceRow, round7};
+use super::tables::{DistanceBound, DistanceRow, round7};
 use crate::error::Result;
 use crate::image::LinearImage;
 use crate::metric::flip::Flip;
@@ -109,6 +114,9 @@ pub struct DistanceJob<'a> {
     pub simplifier_error: Option<f64>,
     /// Asset and LOD names and the LOD's triangle count, for the rows.
     pub names: (&'a str, &'a str, usize),
+    /// The engine's switch distance for this LOD, metres, if the gate checks one: the search
+    /// then also covers the on-screen size at that distance, so the gate gets an answer there.
+    pub switch_m: Option<f64>,
 }
 
 /// "Visible at this probe?"
@@ -174,7 +182,10 @@ pub fn search(
         probes.insert(diameter, worst);
         Ok(worst)
     };
-    let max_d = config.max_diameter_px.0.max(MIN_PROBE);
+    // The sizes searched: MIN_PROBE to max_diameter_px, widened to take in the size at the
+    // switch distance (up to the display's height) so that the gate's question has an answer.
+    let r_m = r_units * job.meters_per_unit;
+    let (min_d, max_d) = probe_range(&display, r_m, config, job.switch_m);
     let mut criteria: Vec<(String, Criterion)> = vec![(
         format!("vdp_p{}", config.probability.0),
         Box::new({
@@ -193,7 +204,7 @@ pub fn search(
         // Bracket: double from the smallest probe until visible or at the limit.
         let mut lo = 0u32; // largest diameter known invisible (0: none yet)
         let mut hi = None; // smallest diameter known visible
-        let mut d = MIN_PROBE.min(max_d);
+        let mut d = min_d;
         loop {
             if visible(&probe(d)?) {
                 hi = Some(d);
@@ -218,10 +229,13 @@ pub fn search(
         }
         // Imperceptible beyond the distance of the largest invisible diameter. When the search hit a
         // limit (visible at the smallest probe, or invisible up to the largest) it is a bound.
-        let resolved = hi.is_some() && lo > 0;
-        let diameter = if lo == 0 { MIN_PROBE.min(max_d) } else { lo };
+        let bound = match (hi, lo) {
+            (Some(_), 0) => DistanceBound::AtLeast,
+            (Some(_), _) => DistanceBound::Measured,
+            (None, _) => DistanceBound::AtMost,
+        };
+        let diameter = if lo == 0 { min_d } else { lo };
         let at = probe(diameter)?;
-        let r_m = r_units * job.meters_per_unit;
         let d_m = display.distance_for(r_m, diameter as f64);
         let (fraction, unreal, coverage) = display.engine_params(r_m, d_m);
         rows.push(DistanceRow {
@@ -237,13 +251,39 @@ pub fn search(
                 .simplifier_error
                 .map(|e| round7(e * job.meters_per_unit * display.k / d_m)),
             diameter_px: round7(display.diameter_px(r_m, d_m)),
-            resolved,
+            resolved: bound == DistanceBound::Measured,
             renderer: crate::backend::CPU_RENDERER.to_string(),
             vdp_probability: Some(round7(at.vdp)),
             vdp_jnd: Some(round7(at.vdp_jnd)),
+            bound,
         });
     }
     Ok(rows)
+}
+
+/// The smallest and largest on-screen diameters searched, pixels: [`MIN_PROBE`] to
+/// `max_diameter_px`, widened to take in the diameter at `switch_m` (at least 1 px, at most the
+/// display's height: beyond it the object is larger than the screen, and the gate says it cannot
+/// check there).
+fn probe_range(
+    display: &Screen,
+    r_m: f64,
+    config: &DistanceConfig,
+    switch_m: Option<f64>,
+) -> (u32, u32) {
+    let max_d = config.max_diameter_px.0.max(MIN_PROBE);
+    let (mut lo, mut hi) = (MIN_PROBE.min(max_d), max_d);
+    if let Some(s) = switch_m {
+        let cap = (display.height_px as u32).max(max_d);
+        let at = if s > r_m {
+            display.diameter_px(r_m, s)
+        } else {
+            f64::INFINITY // the viewer inside the bounding sphere
+        };
+        lo = lo.min(at.floor().clamp(1.0, cap as f64) as u32);
+        hi = hi.max(at.ceil().clamp(1.0, cap as f64) as u32);
+    }
+    (lo, hi)
 }
 
 #[cfg(test)]

@@ -12,7 +12,7 @@ use std::path::Path;
 
 use super::config::config_dir;
 use super::plan::Plan;
-use super::tables::{Results, SummaryRow, higher_is_worse, read_csv};
+use super::tables::{DistanceBound, DistanceRow, Results, SummaryRow, higher_is_worse, read_csv};
 use crate::error::{Error, Location, Result};
 
 /// One failed check.
@@ -111,14 +111,8 @@ pub fn check(plan: &Plan, results: &Results) -> Result<Vec<Failure>> {
                         "set [distance] enabled = true or remove switch_m",
                     ));
                 };
-                if row.imperceptible_beyond_m > switch {
-                    fail(
-                        "switch_m",
-                        format!(
-                            "{} is used from {switch} m but is visible until {:.2} m ({})",
-                            lod.name, row.imperceptible_beyond_m, row.criterion
-                        ),
-                    );
+                if let Some(why) = switch_verdict(&lod.name, switch, row) {
+                    fail("switch_m", why);
                 }
             }
         }
@@ -267,4 +261,77 @@ pub fn against_baseline(
         }
     }
     Ok(out)
+}
+
+/// Why a LOD used from `switch` metres fails the switch check, if it does. The distance search
+/// covers the LOD's on-screen size at `switch` (`distance.rs`), so a bound decides the check too,
+/// and the message says which bound it is: a search limit is never reported as a measured
+/// distance.
+fn switch_verdict(lod: &str, switch: f64, row: &DistanceRow) -> Option<String> {
+    let d = row.imperceptible_beyond_m;
+    let criterion = &row.criterion;
+    match row.bound {
+        DistanceBound::Measured => (d > switch).then(|| {
+            format!("{lod} is used from {switch} m but is visible until {d:.2} m ({criterion})")
+        }),
+        DistanceBound::AtLeast => Some(format!(
+            "{lod} is used from {switch} m but is visible even at {:.0} px across, the smallest \
+             size searched ({criterion}): it stays visible at least until {d:.2} m",
+            row.diameter_px
+        )),
+        DistanceBound::AtMost if d <= switch => None,
+        DistanceBound::AtMost => Some(format!(
+            "{lod} is used from {switch} m, where the object is larger than the display's height; \
+             the search went up to {:.0} px across ({d:.2} m), where the LOD is invisible \
+             ({criterion}), and cannot check nearer: set switch_m to {d:.2} m or more",
+            row.diameter_px
+        )),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn row(d: f64, px: f64, bound: DistanceBound) -> DistanceRow {
+        DistanceRow {
+            asset: "a".into(),
+            lod: "l".into(),
+            triangles: 1,
+            criterion: "vdp_p0.5".into(),
+            imperceptible_beyond_m: d,
+            screen_height_fraction: 0.1,
+            unreal_screen_size: 0.1,
+            screen_coverage: 0.01,
+            pixel_error: None,
+            diameter_px: px,
+            resolved: bound == DistanceBound::Measured,
+            renderer: "cpu".into(),
+            vdp_probability: Some(0.0),
+            vdp_jnd: Some(0.0),
+            bound,
+        }
+    }
+
+    #[test]
+    fn a_bound_decides_the_switch_check_and_is_named_as_one() {
+        use DistanceBound::*;
+        // Measured: fails only when visible beyond the switch distance.
+        assert!(switch_verdict("l", 8.0, &row(6.4, 120.0, Measured)).is_none());
+        let m = switch_verdict("l", 8.0, &row(10.7, 70.0, Measured)).unwrap();
+        assert!(m.contains("visible until 10.70 m"), "{m}");
+        // Invisible at the largest size searched, which took in the switch distance: passes
+        // (an identical LOD used to fail here with the search limit as a "measured" distance).
+        assert!(switch_verdict("l", 8.0, &row(8.0, 96.0, AtMost)).is_none());
+        assert!(switch_verdict("l", 20.0, &row(13.02, 512.0, AtMost)).is_none());
+        // The switch distance lay beyond the search (larger than the display): cannot check.
+        let m = switch_verdict("l", 0.2, &row(0.9, 2160.0, AtMost)).unwrap();
+        assert!(
+            m.contains("cannot check") && !m.contains("visible until"),
+            "{m}"
+        );
+        // Visible even at the smallest size: a lower bound, said as one.
+        let m = switch_verdict("l", 50.0, &row(60.0, 1.0, AtLeast)).unwrap();
+        assert!(m.contains("at least until 60.00 m"), "{m}");
+    }
 }

@@ -239,15 +239,8 @@ pub fn summary_table(outcome: &Outcome) -> String {
     };
     for l in &r.lods {
         let hl = r.headline(&l.asset, &l.lod);
-        let bound = |d: &tables::DistanceRow| if d.resolved { "" } else { "~" };
-        let dist = hl
-            .distance
-            .as_ref()
-            .map(|d| format!("{}{:.2}", bound(d), d.imperceptible_beyond_m));
-        let px = hl
-            .distance
-            .as_ref()
-            .map(|d| format!("{}{:.0}", bound(d), d.diameter_px));
+        let dist = hl.distance.as_ref().map(tables::DistanceRow::distance_text);
+        let px = hl.distance.as_ref().map(tables::DistanceRow::diameter_text);
         let failed = outcome
             .failures
             .iter()

@@ -13,7 +13,6 @@
 
 use std::path::Path;
 
-use super::distance::MIN_PROBE;
 use super::plan::Plan;
 use super::tables::Results;
 use crate::error::Result;
@@ -151,15 +150,12 @@ pub fn write(plan: &Plan, results: &Results, dir: &Path) -> Result<()> {
                     .iter()
                     .filter(|d| d.asset == asset.name && d.criterion == *c)
                 {
-                    let bound = match (d.resolved, d.diameter_px <= MIN_PROBE as f64 + 0.5) {
-                        (true, _) => "",
-                        (false, true) => "≤",
-                        (false, false) => "≥",
-                    };
                     line.points.push((d.triangles as f64, d.diameter_px));
                     line.labels.push(format!(
-                        "{} {bound}{:.0} px · {:.2} m",
-                        d.lod, d.diameter_px, d.imperceptible_beyond_m
+                        "{} {} px · {} m",
+                        d.lod,
+                        d.diameter_text(),
+                        d.distance_text()
                     ));
                 }
                 line

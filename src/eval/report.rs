@@ -111,13 +111,13 @@ pub fn render(plan: &Plan, results: &Results, failures: &[Failure]) -> String {
                 num(hl.psnr_worst, 2),
                 num(hl.vdp_worst, 3),
                 num(hl.vdp_jnd_worst, 2),
-                num(dist.map(|d| d.imperceptible_beyond_m), 2),
+                dist.map_or_else(|| "–".to_string(), |d| esc(&d.distance_text())),
                 if dist.is_some_and(|d| !d.resolved) {
                     " (bound)"
                 } else {
                     ""
                 },
-                num(dist.map(|d| d.diameter_px), 0),
+                dist.map_or_else(|| "–".to_string(), |d| esc(&d.diameter_text())),
                 num(dist.map(|d| d.screen_height_fraction), 4),
                 num(l.switch_m, 2),
                 if bad { "FAIL" } else { "pass" }

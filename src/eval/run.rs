@@ -237,6 +237,7 @@ pub fn run(plan: Plan, options: &RunOptions, progress: &dyn Progress) -> Result<
                     meters_per_unit: asset.meters_per_unit,
                     simplifier_error: lod.info.simplifier_error,
                     names: (&asset.name, &lod.name, lod.info.triangles),
+                    switch_m: lod.info.switch_m,
                 };
                 results.distances.extend(distance::search(
                     &job,

@@ -109,6 +109,58 @@ pub struct DistanceRow {
     /// The same difference in JND (1 = the observers' detection threshold).
     #[serde(default)]
     pub vdp_jnd: Option<f64>,
+    /// Whether `imperceptible_beyond_m` is a measurement or which kind of bound it is.
+    #[serde(default)]
+    pub bound: DistanceBound,
+}
+
+/// What an imperceptibility distance is: measured, or a bound because the search hit one of its
+/// limits. Written to `distances.csv` as `measured`, `at_least` or `at_most`.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum DistanceBound {
+    /// The search bracketed the change from visible to invisible: a measured distance.
+    #[default]
+    Measured,
+    /// Visible even at the smallest size searched: imperceptible only farther than this (the
+    /// on-screen diameter is at most the one given).
+    AtLeast,
+    /// Invisible even at the largest size searched: imperceptible from this distance at the
+    /// latest, perhaps nearer (the diameter is at least the one given).
+    AtMost,
+}
+
+impl DistanceRow {
+    /// The distance in metres as a person reads it: `4.46`, `≥ 16.50` or `≤ 13.02` (a bound is
+    /// never shown as a measurement).
+    pub fn distance_text(&self) -> String {
+        format!(
+            "{}{:.2}",
+            self.bound.distance_sign(),
+            self.imperceptible_beyond_m
+        )
+    }
+
+    /// The on-screen diameter in pixels the same way: `185`, `≤ 4` or `≥ 512`.
+    pub fn diameter_text(&self) -> String {
+        let sign = match self.bound {
+            DistanceBound::Measured => "",
+            DistanceBound::AtLeast => "≤ ",
+            DistanceBound::AtMost => "≥ ",
+        };
+        format!("{sign}{:.0}", self.diameter_px)
+    }
+}
+
+impl DistanceBound {
+    /// "", "≥ " or "≤ " before a distance.
+    pub fn distance_sign(self) -> &'static str {
+        match self {
+            DistanceBound::Measured => "",
+            DistanceBound::AtLeast => "≥ ",
+            DistanceBound::AtMost => "≤ ",
+        }
+    }
 }
 
 /// One line of `summary.csv`.
@@ -402,6 +454,7 @@ impl Columns for DistanceRow {
         "renderer",
         "vdp_probability",
         "vdp_jnd",
+        "bound",
     ];
 }
 
@@ -468,7 +521,7 @@ mod tests {
     fn csv_round_trip_is_exact() {
         let dir = tempfile::tempdir().unwrap();
         let mut r = Results::default();
-        for (i, v) in [0.1234567, 1e-9, f64::INFINITY, 42.0].iter().enumerate() {
+        for (i, v) in [0.1234567, 1e-9, 100.0, 42.0].iter().enumerate() {
             r.rows.push(row("l", i, "psnr", round7(*v)));
         }
         r.write_csvs(dir.path()).unwrap();
@@ -483,6 +536,19 @@ mod tests {
         assert!(d.starts_with(
             "asset,lod,triangles,criterion,imperceptible_beyond_m,screen_height_fraction,"
         ));
+    }
+
+    #[test]
+    fn a_non_finite_value_never_reaches_a_table() {
+        let dir = tempfile::tempdir().unwrap();
+        let mut r = Results::default();
+        r.rows.push(row("l", 0, "psnr", f64::INFINITY));
+        let e = r.write_csvs(dir.path()).unwrap_err().to_string();
+        assert!(
+            e.contains("value = inf") && e.contains("metrics.csv"),
+            "{e}"
+        );
+        assert!(!dir.path().join("metrics.csv").exists());
     }
 
     #[test]
@@ -531,6 +597,7 @@ mod tests {
             renderer: "cpu".into(),
             vdp_probability: Some(0.5),
             vdp_jnd: Some(0.8),
+            bound: DistanceBound::Measured,
         });
     }
 }

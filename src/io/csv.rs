@@ -23,7 +23,14 @@ pub fn write_rows<T: Serialize>(path: &Path, header: Option<&[&str]>, rows: &[T]
     if let Some(h) = header {
         w.write_record(h).map_err(|e| fail(&e))?;
     }
-    for r in rows {
+    for (i, r) in rows.iter().enumerate() {
+        // No NaN or infinity reaches a table (the output guard, `finite.rs`).
+        super::finite::check(r).map_err(|field| {
+            fail(&format!(
+                "row {} has {field}, which is not a finite number",
+                i + 1
+            ))
+        })?;
         w.serialize(r).map_err(|e| fail(&e))?;
     }
     let bytes = w.into_inner().map_err(|e| fail(&e))?;

@@ -311,6 +311,7 @@ pub(crate) fn load(path: &Path, options: &LoadOptions) -> Result<MeshData> {
             file_vertices: b.file_vertices,
             file_faces,
             file_unreferenced: 0,
+            edited: false,
         },
         warnings,
     })

@@ -184,6 +184,9 @@ pub struct Source {
     /// Vertex records no face uses, where the loader dropped them before [`Mesh::new`] could
     /// count them (OBJ); [`Mesh::unreferenced_removed`] adds the ones dropped later.
     pub file_unreferenced: usize,
+    /// True for a mesh built in code from a loaded one (a LOD, an edited copy): its triangles
+    /// are not the file's, and messages about them say so.
+    pub edited: bool,
 }
 
 /// A mesh as a loader produced it, before validation. Every field is plain data; [`Mesh::new`]
@@ -295,7 +298,10 @@ impl Mesh {
             triangles: self.triangles.clone(),
             material_ids: self.material_ids.clone(),
             materials: self.materials.clone(),
-            source: self.source.clone(),
+            source: Source {
+                edited: true,
+                ..self.source.clone()
+            },
             warnings: self.warnings.clone(),
         }
     }

@@ -220,6 +220,7 @@ mod tests {
                 file_vertices: 4,
                 file_faces: 3,
                 file_unreferenced: 0,
+                edited: false,
             },
             warnings: vec![],
         }

@@ -618,6 +618,7 @@ pub(crate) fn load(path: &Path, options: &LoadOptions) -> Result<MeshData> {
             file_vertices: scan.positions,
             file_faces: scan.faces,
             file_unreferenced: scan.unreferenced,
+            edited: false,
         },
         warnings,
     })

@@ -165,6 +165,7 @@ pub(crate) fn load(path: &Path) -> Result<MeshData> {
             file_vertices: nv,
             file_faces: nf,
             file_unreferenced: 0,
+            edited: false,
         },
         warnings: vec![],
     })

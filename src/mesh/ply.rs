@@ -221,6 +221,7 @@ pub(crate) fn load(path: &Path) -> Result<MeshData> {
             file_vertices: vertices.len(),
             file_faces,
             file_unreferenced: 0,
+            edited: false,
         },
         warnings: vec![],
     })

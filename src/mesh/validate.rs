@@ -29,6 +29,13 @@ const REEXPORT: &str = "re-export the mesh from its authoring tool or repair it 
 pub(crate) fn check(data: &MeshData) -> Result<Report> {
     let path = &data.source.path;
     let n = data.positions.len();
+    if data.triangles.is_empty() && data.source.edited {
+        return Err(Error::input(
+            path,
+            "simplifying the mesh left no triangles",
+            "ask for more triangles (a larger ratio or count, a smaller error) or another method",
+        ));
+    }
     if data.triangles.is_empty() {
         return Err(Error::input(
             path,
@@ -71,6 +78,7 @@ pub(crate) fn check(data: &MeshData) -> Result<Report> {
     if let Some(v) = data.positions.iter().position(|p| !p.is_finite()) {
         return non_finite("position", v, fmt_vec(data.positions[v]), REEXPORT);
     }
+    check_scale(data)?;
     let normals = data.normals.as_deref().unwrap_or_default();
     if let Some(v) = normals.iter().position(|p| !p.is_finite()) {
         let fix = "remove the normals to let lodeval compute them, or re-export the mesh";
@@ -126,6 +134,60 @@ pub(crate) fn check(data: &MeshData) -> Result<Report> {
     })
 }
 
+/// The mesh's size and place must suit single precision ([`crate::limits::MESH_EXTENT`],
+/// [`crate::limits::MESH_OFFSET`]): a model 1e30 units across gave infinite bounds and NaN
+/// distances, one 1e-30 across zero-area triangles everywhere, and one far from the origin
+/// merged vertices and blank renders. Computed in f64 from the (finite) f32 positions, which
+/// cannot overflow. Only the vertices triangles use count.
+fn check_scale(data: &MeshData) -> Result<()> {
+    use crate::limits::{MESH_EXTENT, MESH_OFFSET, Quantity};
+    let mut lo = [f64::INFINITY; 3];
+    let mut hi = [f64::NEG_INFINITY; 3];
+    let (mut far, mut far_v) = (0.0f64, 0usize);
+    let n = data.positions.len();
+    for &i in data
+        .triangles
+        .iter()
+        .flatten()
+        .filter(|&&i| (i as usize) < n)
+    {
+        let p = data.positions[i as usize].to_array().map(f64::from);
+        for k in 0..3 {
+            lo[k] = lo[k].min(p[k]);
+            hi[k] = hi[k].max(p[k]);
+            if p[k].abs() > far {
+                (far, far_v) = (p[k].abs(), i as usize);
+            }
+        }
+    }
+    let size = (0..3).map(|k| (hi[k] - lo[k]).powi(2)).sum::<f64>().sqrt();
+    let fix = "scale the model to sensible units (e.g. metres) and move it to the origin in its \
+               authoring tool (Blender: Object > Set Origin, then Apply > All Transforms)";
+    if let Some(m) = MESH_EXTENT.refuse(size) {
+        return Err(Error::input(
+            &data.source.path,
+            format!("the mesh's bounding-box diagonal {m}"),
+            fix,
+        ));
+    }
+    if MESH_OFFSET.refuse(far / size).is_some() {
+        return Err(Error::input_at(
+            &data.source.path,
+            Location::Element(format!("vertex {far_v}")),
+            format!(
+                "{} is {} units from the origin, {} times the mesh's size ({}): {}",
+                fmt_vec(data.positions[far_v]),
+                far.show(),
+                (far / size).show(),
+                size.show(),
+                MESH_OFFSET.outside()
+            ),
+            fix,
+        ));
+    }
+    Ok(())
+}
+
 /// Remove vertices no triangle references, renumbering triangles; returns how many were removed.
 /// Requires `check` to have passed.
 pub(crate) fn compact_unreferenced(data: &mut MeshData) -> usize {
@@ -174,7 +236,8 @@ pub(crate) fn compact_unreferenced(data: &mut MeshData) -> usize {
 }
 
 fn fmt_vec(v: Vec3) -> String {
-    format!("({}, {}, {})", v.x, v.y, v.z)
+    use crate::limits::Quantity;
+    format!("({}, {}, {})", v.x.show(), v.y.show(), v.z.show())
 }
 
 impl Error {
@@ -207,6 +270,7 @@ mod tests {
                 file_vertices: 4,
                 file_faces: 4,
                 file_unreferenced: 0,
+                edited: false,
             },
             warnings: vec![],
         }

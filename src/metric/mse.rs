@@ -5,8 +5,12 @@
 //! over l views of m × n pixels.
 //!
 //! Decision: "luminance" is Rec. 709 Y of linear RGB (README, Architecture, "Colour"), so MSE is in linear
-//! luminance units and PSNR uses a peak of 1 (display white). Identical images have MSE 0 and PSNR
-//! +∞ (reported as `f64::INFINITY`).
+//! luminance units and PSNR uses a peak of 1 (display white).
+//!
+//! Decision: PSNR saturates at [`PSNR_CEILING_DB`] = 100 dB (an RMS difference of 1e-5 of white,
+//! far below one 8-bit step), as libvmaf clips PSNR at 60 dB for 8-bit video: identical images
+//! (MSE 0) read 100 dB, so no infinity reaches a CSV, a summary mean or the gate. The `mse` value
+//! beside it stays exact (0 for identical images).
 
 use rayon::prelude::*;
 
@@ -21,17 +25,20 @@ pub struct MseScore {
     pub mse: f64,
     /// Its square root (linear luminance).
     pub rmse: f64,
-    /// 10·log10(1 / MSE) in dB; +∞ for identical images.
+    /// 10·log10(1 / MSE) in dB, at most [`PSNR_CEILING_DB`] (identical images read the ceiling).
     pub psnr_db: f64,
 }
 
+/// The highest PSNR reported, dB: MSE 1e-10 of white and below, identical images included.
+pub const PSNR_CEILING_DB: f64 = 100.0;
+
 impl MseScore {
-    /// The scores for a mean squared error (PSNR +∞ for 0).
+    /// The scores for a mean squared error (PSNR saturating at [`PSNR_CEILING_DB`]).
     pub fn from_mse(mse: f64) -> MseScore {
-        let psnr_db = if mse == 0.0 {
-            f64::INFINITY
+        let psnr_db = if mse > 0.0 {
+            (10.0 * (1.0 / mse).log10()).min(PSNR_CEILING_DB)
         } else {
-            10.0 * (1.0 / mse).log10()
+            PSNR_CEILING_DB
         };
         MseScore {
             mse,
@@ -94,7 +101,7 @@ mod tests {
         let b = LinearImage::new(2, 2, vec![Vec3::splat(0.5); 4]).unwrap();
         let s = mse(&a, &b).unwrap();
         assert!((s.mse - 0.25).abs() < 1e-7 && (s.psnr_db - 6.020_599_9).abs() < 1e-5);
-        assert_eq!(mse(&a, &a).unwrap().psnr_db, f64::INFINITY);
+        assert_eq!(mse(&a, &a).unwrap().psnr_db, PSNR_CEILING_DB);
         // d_MS over two views weights pixels, not views: (4·0.25 + 4·0) / 8.
         assert!((d_ms(&[(&a, &b), (&a, &a)]).unwrap() - 0.125).abs() < 1e-7);
     }

@@ -162,6 +162,7 @@ fn quad_mesh() -> Mesh {
             file_vertices: 4,
             file_faces: 2,
             file_unreferenced: 0,
+            edited: false,
         },
         warnings: vec![],
     };

@@ -461,6 +461,7 @@ fn half_the_triangles_of_a_dense_scan_is_invisible_at_a_hundred_and_fifty_pixels
         meters_per_unit: 1.0,
         simplifier_error: None,
         names: ("bunny", "meshopt-r50", 0),
+        switch_m: None,
     };
     let config = DistanceConfig {
         flip_mean: None,

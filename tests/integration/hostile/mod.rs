@@ -12,17 +12,23 @@
 //!   samples, benchmark meshes, contact sheets), refused with the bound of `src/limits.rs`.
 //! - `gltf`: glTF structure the parser accepts but nothing can read through (a node cycle, which
 //!   used to hang with growing memory; two parents; accessors and views past their ends).
+//! - `distances`: a bound is not a measured distance (an identical LOD failed `switch_m` with
+//!   the search limit as "visible until"); the `bound` column, `≤`/`≥` on the console.
 //! - `files`: paths that are not regular files (a FIFO, `/dev/zero`, `/dev/urandom`, a symlink
 //!   to one, a folder) as a mesh, material library, texture, glTF buffer or image, image or
 //!   config, which used to block or read until memory ran out.
+//! - `numbers`: meshes beyond single precision (1e30, 1e-30, far from the origin) refused; what
+//!   is within the bounds scores with finite numbers only; NaN pixels refused; PSNR saturates.
 //! - `obj_text`: OBJ text that loaded wrong (a byte-order mark, `usemtl` of an undefined
 //!   material) or not at all (Latin-1 in a comment).
 
 mod baseline;
 mod bounds;
+mod distances;
 mod files;
 mod gltf;
 mod goals;
+mod numbers;
 mod obj_text;
 mod plan;
 
