@@ -79,6 +79,46 @@ pub fn read_input_text(path: &Path, what: &str, limit: u64, fix: &str) -> Result
     })
 }
 
+/// `Err` when writing any of `outputs` would replace one of `inputs` (the same file through any
+/// path, symlink or hard link): lodeval never overwrites what it reads (`-o` naming the input
+/// mesh used to replace it). Outputs that do not exist yet pass.
+pub fn check_not_inputs(outputs: &[PathBuf], inputs: &[PathBuf]) -> Result<()> {
+    for out in outputs {
+        let Ok(o) = std::fs::metadata(out) else {
+            continue;
+        };
+        if let Some(input) = inputs
+            .iter()
+            .find(|i| std::fs::metadata(i).is_ok_and(|m| same_file(&o, &m, out, i)))
+        {
+            let which = if input == out {
+                String::new()
+            } else {
+                format!(" ({})", input.display())
+            };
+            return Err(Error::input(
+                out,
+                format!(
+                    "is an input of this run{which}; writing the output there would destroy it"
+                ),
+                "choose another output path",
+            ));
+        }
+    }
+    Ok(())
+}
+
+#[cfg(unix)]
+fn same_file(a: &std::fs::Metadata, b: &std::fs::Metadata, _: &Path, _: &Path) -> bool {
+    use std::os::unix::fs::MetadataExt;
+    a.dev() == b.dev() && a.ino() == b.ino()
+}
+
+#[cfg(not(unix))]
+fn same_file(_: &std::fs::Metadata, _: &std::fs::Metadata, a: &Path, b: &Path) -> bool {
+    matches!((a.canonicalize(), b.canonicalize()), (Ok(x), Ok(y)) if x == y)
+}
+
 /// Write `bytes` to `path` atomically (temp file in the same folder, then rename).
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
     let dir = match path.parent() {

@@ -23,7 +23,7 @@ fn main() -> ExitCode {
              CPU with RUSTFLAGS=\"\" cargo build --release (see .cargo/config.toml)",
             missing.join(", ")
         ));
-        eprintln!("error: {e}");
+        report(&e);
         return ExitCode::from(e.exit_code());
     }
     let cli = cli::Cli::parse();
@@ -43,8 +43,14 @@ fn main() -> ExitCode {
     match outcome {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
-            eprintln!("error: {e}");
+            report(&e);
             ExitCode::from(e.exit_code())
         }
     }
+}
+
+/// The one error line on standard error; a full or closed stderr cannot turn it into a panic.
+fn report(e: &Error) {
+    use std::io::Write as _;
+    let _ = writeln!(std::io::stderr().lock(), "error: {e}");
 }

@@ -34,6 +34,14 @@ pub fn optimize(
     }
     let original = std::sync::Arc::new(mesh::load(&job.original, &LoadOptions::default())?);
     let simplified = std::sync::Arc::new(mesh::load(&job.simplified, &LoadOptions::default())?);
+    // Neither the mesh nor the energy log may replace a file either input was read from.
+    let mut outputs = crate::mesh::write_obj::planned_files(&simplified, &job.out);
+    outputs.extend(job.energy_csv.clone());
+    let inputs: Vec<std::path::PathBuf> = [&original, &simplified]
+        .iter()
+        .flat_map(|m| m.source().files.iter().cloned())
+        .collect();
+    crate::io::check_not_inputs(&outputs, &inputs)?;
     progress.start(Some(job.options.evals), "evaluations", "");
     let outcome = lindstrom_turk::optimize(&original, &simplified, &job.options, &|n| {
         progress.set_position(n)

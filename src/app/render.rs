@@ -85,6 +85,18 @@ pub fn render(job: &RenderJob) -> Result<RenderReport> {
         .map(|w| format!("{}: {w}", job.mesh.display()))
         .chain(engine.fallback().map(str::to_string))
         .collect();
+    // No output may replace a file the mesh was read from (a texture named as -o, say).
+    let pngs: Vec<PathBuf> = match &job.views {
+        ViewSelection::One { out, .. } | ViewSelection::Sheet { out } => vec![out.clone()],
+        ViewSelection::All { out_dir } => (0..cameras.len())
+            .map(|k| out_dir.join(format!("view-{k:02}.png")))
+            .collect(),
+    };
+    let outputs: Vec<PathBuf> = pngs
+        .iter()
+        .flat_map(|p| std::iter::once(p.clone()).chain(job.exr.then(|| p.with_extension("exr"))))
+        .collect();
+    crate::io::check_not_inputs(&outputs, &mesh.source().files)?;
     let mut written = Vec::new();
     match &job.views {
         ViewSelection::One { view, out } => {

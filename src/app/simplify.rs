@@ -54,6 +54,13 @@ pub fn simplify(
     progress: &dyn crate::progress::Progress,
 ) -> Result<Vec<SimplifyRow>> {
     let mesh = load_for_lod(&job.mesh, &job.out)?;
+    // Every file of the chain is checked before the simplifier runs: none may be an input.
+    let files: Vec<PathBuf> = job.goals.iter().map(|g| lod_file(job, g)).collect();
+    let planned: Vec<PathBuf> = files
+        .iter()
+        .flat_map(|f| crate::mesh::write_obj::planned_files(&mesh, f))
+        .collect();
+    crate::io::check_not_inputs(&planned, &mesh.source().files)?;
     let start = std::time::Instant::now();
     progress.start(
         None,
@@ -68,24 +75,8 @@ pub fn simplify(
     progress.finish();
     let lods = lods?;
     let seconds = start.elapsed().as_secs_f64();
-    let stem = job
-        .out
-        .file_stem()
-        .map_or_else(|| "lod".into(), |s| s.to_string_lossy().into_owned());
     let mut rows = Vec::new();
-    for (lod, goal) in lods.iter().zip(&job.goals) {
-        let file = if job.chain {
-            let suffix = match goal {
-                crate::simplify::Goal::Ratio(r) => {
-                    format!("r{}", crate::eval::config::percent_label(*r))
-                }
-                crate::simplify::Goal::Triangles(t) => format!("t{t}"),
-                crate::simplify::Goal::Error(e) => format!("e{e}"),
-            };
-            job.out.with_file_name(format!("{stem}-{suffix}.obj"))
-        } else {
-            job.out.clone()
-        };
+    for (lod, file) in lods.iter().zip(files) {
         crate::mesh::write_obj::write(&lod.mesh, &file)?;
         rows.push(SimplifyRow {
             file,
@@ -96,6 +87,26 @@ pub fn simplify(
         });
     }
     Ok(rows)
+}
+
+/// The file a LOD of `goal` goes to: `out` itself, or in a chain `STEM-r50.obj`, `STEM-t1000.obj`,
+/// `STEM-e0.01.obj` beside it.
+fn lod_file(job: &SimplifyJob, goal: &crate::simplify::Goal) -> PathBuf {
+    if !job.chain {
+        return job.out.clone();
+    }
+    let stem = job
+        .out
+        .file_stem()
+        .map_or_else(|| "lod".into(), |s| s.to_string_lossy().into_owned());
+    let suffix = match goal {
+        crate::simplify::Goal::Ratio(r) => {
+            format!("r{}", crate::eval::config::percent_label(*r))
+        }
+        crate::simplify::Goal::Triangles(t) => format!("t{t}"),
+        crate::simplify::Goal::Error(e) => format!("e{e}"),
+    };
+    job.out.with_file_name(format!("{stem}-{suffix}.obj"))
 }
 
 /// Which views a Williams et al. LOD is made for.

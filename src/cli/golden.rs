@@ -34,7 +34,7 @@ pub(crate) fn run(a: GoldenArgs) -> Result<(), Error> {
         ));
     }
     for m in &g.mismatches {
-        eprintln!("{m}");
+        note!("{m}");
     }
     if g.mismatches.is_empty() {
         emit(&format!(

@@ -3,6 +3,15 @@
 //! back; `args.rs` holds the value types several commands share, `print.rs` the output, and
 //! `progress.rs` the terminal and log progress reporter the library's jobs report through.
 
+/// `eprintln!` that never panics: a message to a closed or full standard error is dropped
+/// (the exit code still tells the outcome).
+macro_rules! note {
+    ($($arg:tt)*) => {{
+        use std::io::Write as _;
+        let _ = writeln!(std::io::stderr().lock(), $($arg)*);
+    }};
+}
+
 mod args;
 mod bench;
 mod calibrate;

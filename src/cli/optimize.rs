@@ -7,6 +7,7 @@ use clap::{Args, ValueEnum};
 use lodeval::Error;
 
 use super::args::count;
+use super::print::emit;
 use super::progress::Reporter;
 
 /// `--normals`.
@@ -61,10 +62,13 @@ pub(crate) fn run(a: OptimizeArgs, quiet: bool) -> Result<(), Error> {
     if let Some(config) = &a.experiment {
         let rows = lodeval::experiments::lindstrom_turk::run(config, &mut |line| {
             if !quiet {
-                eprintln!("{line}");
+                note!("{line}");
             }
         })?;
-        println!("{} runs; results.csv and plots written", rows.len());
+        emit(&format!(
+            "{} runs; results.csv and plots written\n",
+            rows.len()
+        ))?;
         return Ok(());
     }
     let (Some(original), Some(simplified), Some(out)) =
@@ -98,8 +102,8 @@ pub(crate) fn run(a: OptimizeArgs, quiet: bool) -> Result<(), Error> {
         options,
     };
     let o = lodeval::app::optimize(&job, &Reporter::new(quiet))?;
-    println!(
-        "{}  {} vertices  d_MS {:.6e} -> {:.6e} ({:.1} % of the input's energy)  {} evaluations in {:.1} s ({:.0}/s)  accepted: {} no-op, {} swap, {} teleport",
+    emit(&format!(
+        "{}  {} vertices  d_MS {:.6e} -> {:.6e} ({:.1} % of the input's energy)  {} evaluations in {:.1} s ({:.0}/s)  accepted: {} no-op, {} swap, {} teleport\n",
         out.display(),
         o.vertices.1,
         o.initial_d_ms,
@@ -111,6 +115,6 @@ pub(crate) fn run(a: OptimizeArgs, quiet: bool) -> Result<(), Error> {
         o.accepted.no_op,
         o.accepted.swap,
         o.accepted.teleport
-    );
+    ))?;
     Ok(())
 }

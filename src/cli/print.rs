@@ -20,9 +20,12 @@ pub(crate) fn emit_json<T: serde::Serialize>(value: &T) -> Result<(), Error> {
 pub(crate) fn emit(text: &str) -> Result<(), Error> {
     let mut out = std::io::stdout().lock();
     match out.write_all(text.as_bytes()).and_then(|_| out.flush()) {
-        Err(e) if e.kind() != std::io::ErrorKind::BrokenPipe => Err(Error::Internal(format!(
-            "cannot write to standard output: {e}"
-        ))),
+        // Not a lodeval bug: the output went to a full device or a failing file.
+        Err(e) if e.kind() != std::io::ErrorKind::BrokenPipe => Err(Error::input(
+            std::path::Path::new("<standard output>"),
+            format!("cannot write: {e}"),
+            "free space on the device standard output goes to, or redirect it elsewhere",
+        )),
         _ => Ok(()),
     }
 }
@@ -33,7 +36,7 @@ pub(crate) fn gate_result(outcome: &lodeval::eval::Outcome) -> Result<(), Error>
     warnings(&outcome.warnings);
     emit(&lodeval::eval::summary_table(outcome))?;
     for f in &outcome.failures {
-        eprintln!("{}", f.message);
+        note!("{}", f.message);
     }
     if outcome.failures.is_empty() {
         emit(&format!("wrote {}\n", outcome.out_dir.display()))
@@ -49,6 +52,6 @@ pub(crate) fn gate_result(outcome: &lodeval::eval::Outcome) -> Result<(), Error>
 /// Print warnings the library returned, one `warning:` line each, on stderr.
 pub(crate) fn warnings(lines: &[String]) {
     for w in lines {
-        eprintln!("warning: {w}");
+        note!("warning: {w}");
     }
 }

@@ -68,7 +68,7 @@ impl Stage {
     fn tick(&mut self) {
         if self.last_line.elapsed() >= LOG_EVERY {
             self.last_line = Instant::now();
-            eprintln!("{}", self.line());
+            note!("{}", self.line());
         }
     }
 }

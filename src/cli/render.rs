@@ -100,7 +100,7 @@ pub(crate) fn run(a: RenderArgs, quiet: bool) -> Result<(), Error> {
     let report = lodeval::app::render(&a.job()?)?;
     warnings(&report.warnings);
     if !quiet {
-        eprintln!(
+        note!(
             "wrote {} file(s), first {}",
             report.written.len(),
             report.written[0].display()

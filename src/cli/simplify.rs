@@ -135,9 +135,8 @@ pub(crate) struct SimplifyArgs {
 /// Run `simplify`.
 pub(crate) fn run(a: SimplifyArgs, quiet: bool) -> Result<(), Error> {
     if let Some(config) = &a.experiment {
-        let rows =
-            lodeval::experiments::williams2003::run(config, &mut |line| eprintln!("{line}"))?;
-        eprintln!("{} curve points written", rows.len());
+        let rows = lodeval::experiments::williams2003::run(config, &mut |line| note!("{line}"))?;
+        note!("{} curve points written", rows.len());
         return Ok(());
     }
     if a.method == MethodArg::Williams {
@@ -146,12 +145,12 @@ pub(crate) fn run(a: SimplifyArgs, quiet: bool) -> Result<(), Error> {
             return emit_json(&rows);
         }
         for r in &rows {
-            println!(
-                "{}  {} triangles ({:.4} of the input)",
+            emit(&format!(
+                "{}  {} triangles ({:.4} of the input)\n",
                 r.file.display(),
                 r.triangles,
                 r.ratio
-            );
+            ))?;
         }
         return Ok(());
     }
@@ -222,7 +221,7 @@ fn warn_short_of_goals(
             Goal::Error(_) => continue,
         };
         if r.triangles as f64 > 1.05 * target + 2.0 {
-            eprintln!(
+            note!(
                 "warning: {}: {method} stopped at {} triangles, short of the goal of {target}: \
                  every remaining collapse would change the surface's topology or fold it over \
                  (closed parts are not collapsed away, borders only shrink along themselves). Ask \

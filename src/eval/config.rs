@@ -609,6 +609,13 @@ impl Config {
                 "add at least one [[asset]] with a name and a mesh",
             ));
         }
+        if self.out.as_ref().is_some_and(|o| o.as_os_str().is_empty()) {
+            return Err(fail(
+                "out",
+                "out is empty, which would write into the config's own folder".into(),
+                "name an output folder, e.g. out = \"../results/NAME\", or leave out away",
+            ));
+        }
         let v = &self.viewing;
         if let Err(e) = Display::new(
             v.peak_cd_m2.0 as f32,

@@ -59,6 +59,10 @@ pub fn run(plan: &Plan, bless: bool, ci: bool, out_dir: &Path) -> Result<GoldenO
     }
     let cfg = &plan.config;
     let dir = golden_dir(plan);
+    // Mismatch images of an earlier run go first, so what is left is this run's.
+    let mut inputs = plan.input_files();
+    inputs.push(dir.clone());
+    super::out::prepare(out_dir, super::out::GOLDEN, &inputs)?;
     let settings = cfg.render.settings();
     let flip = Flip::new(cfg.viewing.viewing().ppd() as f32);
     let mut outcome = GoldenOutcome::default();

@@ -10,7 +10,9 @@
 //! - `gate.rs` — thresholds, switch distances, baseline comparison;
 //! - `junit.rs`, `report.rs` — `junit.xml`, `report.html`;
 //! - `plots.rs` — `plots/*.png` (error against triangles, switch distances);
-//! - `golden.rs` — golden-image compare and bless.
+//! - `golden.rs` — golden-image compare and bless;
+//! - `manifest.rs` — `shard.json`: the cases a run covered and the files it wrote (hashes);
+//! - `out.rs` — the output folder: what a run owns there, checked and cleared before it starts.
 //!
 //! This file joins them: [`eval`] runs a config (or one shard of it) and writes every output,
 //! [`merge`] joins shard outputs into exactly the files one machine would have written. Every
@@ -22,6 +24,8 @@ pub mod distance;
 pub mod gate;
 pub mod golden;
 pub mod junit;
+mod manifest;
+pub mod out;
 pub mod plan;
 pub mod plots;
 pub mod report;
@@ -31,7 +35,7 @@ pub mod tables;
 
 use std::path::{Path, PathBuf};
 
-use serde::{Deserialize, Serialize};
+use manifest::Manifest;
 
 pub use gate::Failure;
 pub use plan::{Plan, Shard};
@@ -55,15 +59,6 @@ pub struct Outcome {
     pub warnings: Vec<String>,
 }
 
-/// `shard.json`: what a (shard of a) run covered.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-struct Manifest {
-    config_path: PathBuf,
-    config_text: String,
-    shard: String,
-    cases: Vec<String>,
-}
-
 /// Run a config (one shard of it) and write every output.
 pub fn eval(
     config: &Path,
@@ -83,6 +78,7 @@ pub fn eval(
             .into_iter()
             .filter(|c| options.shard.contains(c))
             .collect(),
+        files: Vec::new(),
     };
     let mut outcome = finish(out.plan, out.out_dir, out.results, &manifest)?;
     outcome.warnings = out.warnings;
@@ -102,7 +98,11 @@ fn finish(plan: Plan, out_dir: PathBuf, results: Results, manifest: &Manifest) -
         report::render(&plan, &results, &failures).as_bytes(),
     )?;
     plots::write(&plan, &results, &out_dir)?;
-    let json = serde_json::to_string_pretty(manifest)
+    let manifest = Manifest {
+        files: manifest::record(&out_dir)?,
+        ..manifest.clone()
+    };
+    let json = serde_json::to_string_pretty(&manifest)
         .map_err(|e| Error::Internal(format!("shard.json: {e}")))?;
     crate::io::write_atomic(&out_dir.join("shard.json"), json.as_bytes())?;
     Ok(Outcome {
@@ -115,11 +115,14 @@ fn finish(plan: Plan, out_dir: PathBuf, results: Results, manifest: &Manifest) -
 }
 
 /// Join the outputs of shard runs into `out`: fails (exit 2) when the shards ran different
-/// configs, a case ran twice, or a case of the plan is missing.
+/// configs, a case ran twice, a case of the plan is missing, a shard's files differ from what it
+/// recorded in `shard.json`, or `out` is (or holds, or lies in) a shard folder. Everything is
+/// checked before anything is written, so a failed merge leaves no half-made folder.
 pub fn merge(dirs: &[PathBuf], out: &Path) -> Result<Outcome> {
     if dirs.is_empty() {
         return Err(Error::Usage("merge needs at least one shard folder".into()));
     }
+    // The shards: manifests, each folder's files against its manifest, the tables.
     let mut manifests = Vec::new();
     for d in dirs {
         let path = d.join("shard.json");
@@ -136,6 +139,7 @@ pub fn merge(dirs: &[PathBuf], out: &Path) -> Result<Outcome> {
                 "give folders written by `lodeval eval --shard`",
             )
         })?;
+        manifest::verify(d, &m)?;
         manifests.push(m);
     }
     let first = &manifests[0];
@@ -172,23 +176,81 @@ pub fn merge(dirs: &[PathBuf], out: &Path) -> Result<Outcome> {
         )));
     }
     let mut results = Results::default();
-    for d in dirs {
+    for (d, m) in dirs.iter().zip(&manifests) {
         let r = Results::read_csvs(d)?;
+        // Every row belongs to one of the shard's own cases.
+        let cases = r.rows.iter().map(|x| (&x.asset, &x.lod));
+        let cases = cases.chain(r.lods.iter().map(|x| (&x.asset, &x.lod)));
+        let cases = cases.chain(r.distances.iter().map(|x| (&x.asset, &x.lod)));
+        for (asset, lod) in cases {
+            let id = plan::case_id(asset, lod);
+            if !m.cases.contains(&id) {
+                return Err(Error::input(
+                    &d.join("shard.json"),
+                    format!("the shard's tables hold case {id}, which it did not run"),
+                    manifest::FIX,
+                ));
+            }
+        }
         results.rows.extend(r.rows);
         results.lods.extend(r.lods);
         results.distances.extend(r.distances);
-        for sub in ["heatmaps", "sheets"] {
+    }
+    results.sort(&all);
+    // The output folder: not a shard folder, nor inside or around one; then cleared.
+    for d in dirs {
+        if same_or_nested(out, d) {
+            return Err(Error::Usage(format!(
+                "--out {} is, holds or lies inside the shard folder {}: the merge would overwrite                  its input; merge into a new folder",
+                out.display(),
+                d.display()
+            )));
+        }
+    }
+    out::prepare(out, out::EVAL, &[])?;
+    for d in dirs {
+        for sub in manifest::IMAGE_DIRS {
             copy_tree(&d.join(sub), &out.join(sub))?;
         }
     }
-    results.sort(&all);
     let manifest = Manifest {
         config_path: first.config_path.clone(),
         config_text: first.config_text.clone(),
         shard: "0/1".into(),
         cases: all,
+        files: Vec::new(),
     };
     finish(plan, out.to_path_buf(), results, &manifest)
+}
+
+/// Whether `a` and `b` are the same folder or one lies inside the other (compared canonically
+/// where they exist; a folder that does not exist yet is compared by its nearest existing
+/// ancestor joined with the rest).
+fn same_or_nested(a: &Path, b: &Path) -> bool {
+    let (a, b) = (canonical(a), canonical(b));
+    a.starts_with(&b) || b.starts_with(&a)
+}
+
+/// `path` made absolute through its nearest existing ancestor.
+fn canonical(path: &Path) -> PathBuf {
+    let mut rest = Vec::new();
+    let mut p = path.to_path_buf();
+    loop {
+        if let Ok(c) = p.canonicalize() {
+            return rest.into_iter().rev().fold(c, |acc, part| acc.join(part));
+        }
+        match (p.file_name().map(|f| f.to_os_string()), p.parent()) {
+            (Some(f), Some(parent)) => {
+                rest.push(f);
+                p = if parent.as_os_str().is_empty() {
+                    PathBuf::from(".")
+                } else {
+                    parent.to_path_buf()
+                };
+            }
+            _ => return path.to_path_buf(),
+        }
+    }
 }
 
 fn copy_tree(from: &Path, to: &Path) -> Result<()> {
@@ -202,13 +264,12 @@ fn copy_tree(from: &Path, to: &Path) -> Result<()> {
         if src.is_dir() {
             copy_tree(&src, &dst)?;
         } else {
-            let bytes = std::fs::read(&src).map_err(|err| {
-                Error::input(
-                    &src,
-                    format!("cannot read: {err}"),
-                    "check the shard folder",
-                )
-            })?;
+            let bytes = crate::io::read_input(
+                &src,
+                "shard image",
+                crate::limits::IMAGE_BYTES,
+                "check the shard folder",
+            )?;
             crate::io::write_atomic(&dst, &bytes)?;
         }
     }

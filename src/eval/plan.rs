@@ -106,6 +106,23 @@ pub fn case_id(asset: &str, lod: &str) -> String {
 }
 
 impl Plan {
+    /// The files the plan reads, as written in it: the config, the gate's baseline, every
+    /// original and LOD mesh (what an output folder must never hold among what it clears).
+    pub fn input_files(&self) -> Vec<PathBuf> {
+        let mut files = vec![self.config_path.clone()];
+        if let Some(b) = &self.config.gate.baseline {
+            files.push(resolve(&config_dir(&self.config_path), b));
+        }
+        for a in &self.assets {
+            files.push(a.mesh.clone());
+            files.extend(a.lods.iter().filter_map(|l| match &l.source {
+                LodSource::File(p) => Some(p.clone()),
+                LodSource::Generated { .. } => None,
+            }));
+        }
+        files
+    }
+
     /// Parse and expand a config file.
     pub fn load(config_path: &Path) -> Result<Plan> {
         let text = crate::io::read_input_text(
@@ -114,7 +131,44 @@ impl Plan {
             crate::limits::CONFIG_BYTES,
             "check the path",
         )?;
-        Plan::from_text(text, config_path)
+        let plan = Plan::from_text(text, config_path)?;
+        plan.check_meshes()?;
+        Ok(plan)
+    }
+
+    /// Every mesh the config names exists, before anything is loaded or rendered (a missing
+    /// second asset used to fail after the first was done). The message gives the line and
+    /// where the path led, relative to the config's folder. Not part of [`Plan::from_text`]:
+    /// `merge` rebuilds plans of runs made on other machines.
+    fn check_meshes(&self) -> Result<()> {
+        let written = self.config.assets.iter().flat_map(|a| {
+            std::iter::once((a, &a.mesh)).chain(a.lods.iter().map(move |l| (a, &l.mesh)))
+        });
+        let base = config_dir(&self.config_path);
+        for (asset, mesh) in written {
+            let resolved = resolve(&base, mesh);
+            if resolved.exists() {
+                continue;
+            }
+            let quoted = format!("\"{}\"", mesh.display());
+            let problem = format!(
+                "asset '{}': mesh {quoted} is not there ({}): paths in a config are relative to \
+                 the config file's folder",
+                asset.name.0,
+                resolved.display()
+            );
+            let fix = "fix the path, relative to the config file";
+            return Err(match self.config_text.find(&quoted) {
+                Some(i) => Error::input_at(
+                    &self.config_path,
+                    crate::error::Location::Line(self.config_text[..i].matches('\n').count() + 1),
+                    problem,
+                    fix,
+                ),
+                None => Error::input(&self.config_path, problem, fix),
+            });
+        }
+        Ok(())
     }
 
     /// Expand config text; `config_path` anchors relative paths.

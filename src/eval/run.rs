@@ -75,6 +75,8 @@ pub fn run(plan: Plan, options: &RunOptions, progress: &dyn Progress) -> Result<
     let out_dir = plan
         .config
         .out_dir(&plan.config_path, options.out.as_deref());
+    // Before anything is rendered: the folder is lodeval's, and an earlier run's outputs go.
+    super::out::prepare(&out_dir, super::out::EVAL, &plan.input_files())?;
     let cfg = &plan.config;
     let viewing = cfg.viewing.viewing();
     let scorer = Scorer::new(

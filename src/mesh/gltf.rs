@@ -116,6 +116,22 @@ pub(crate) fn load(path: &Path, options: &LoadOptions) -> Result<MeshData> {
     super::gltf_check::check(path, &root)?;
     let document = gltf::Document::from_json(root).map_err(invalid)?;
     let base = path.parent().unwrap_or(Path::new("."));
+    // Every file the document reads, besides itself (never to be overwritten by an output).
+    let mut files = vec![path.to_path_buf()];
+    for buffer in document.buffers() {
+        if let gltf::buffer::Source::Uri(uri) = buffer.source()
+            && !uri.starts_with("data:")
+        {
+            files.push(base.join(uri));
+        }
+    }
+    for image in document.images() {
+        if let gltf::image::Source::Uri { uri, .. } = image.source()
+            && !uri.starts_with("data:")
+        {
+            files.push(base.join(uri));
+        }
+    }
     // Name a missing external buffer ourselves; the import error would only say "not found".
     for buffer in document.buffers() {
         if let gltf::buffer::Source::Uri(uri) = buffer.source() {
@@ -312,6 +328,7 @@ pub(crate) fn load(path: &Path, options: &LoadOptions) -> Result<MeshData> {
             file_faces,
             file_unreferenced: 0,
             edited: false,
+            files,
         },
         warnings,
     })

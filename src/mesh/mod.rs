@@ -187,6 +187,9 @@ pub struct Source {
     /// True for a mesh built in code from a loaded one (a LOD, an edited copy): its triangles
     /// are not the file's, and messages about them say so.
     pub edited: bool,
+    /// Every file read to build the mesh: the mesh file, its material libraries, textures, glTF
+    /// buffers and images. Nothing lodeval writes may be one of them.
+    pub files: Vec<PathBuf>,
 }
 
 /// A mesh as a loader produced it, before validation. Every field is plain data; [`Mesh::new`]
@@ -404,11 +407,7 @@ pub fn load(path: &Path, options: &LoadOptions) -> Result<Mesh> {
 pub fn load_unguarded(path: &Path, options: &LoadOptions) -> Result<Mesh> {
     let format = Format::from_path(path)?;
     if !path.exists() {
-        return Err(Error::input(
-            path,
-            "file not found",
-            "check the path (it is resolved relative to the current directory)",
-        ));
+        return Err(Error::input(path, "file not found", "check the path"));
     }
     if path.is_dir() {
         return Err(Error::input(

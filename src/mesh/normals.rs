@@ -221,6 +221,7 @@ mod tests {
                 file_faces: 3,
                 file_unreferenced: 0,
                 edited: false,
+                files: Vec::new(),
             },
             warnings: vec![],
         }

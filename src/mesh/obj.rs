@@ -604,6 +604,11 @@ pub(crate) fn load(path: &Path, options: &LoadOptions) -> Result<MeshData> {
     if needs_default {
         out_materials.push(Material::default_material());
     }
+    let mut files = vec![path.to_path_buf()];
+    files.extend(mtl_paths.into_values().filter(|p| p.is_file()));
+    files.extend(cache.paths());
+    files.sort();
+    files.dedup();
     Ok(MeshData {
         positions,
         normals: has_n.then_some(normals),
@@ -619,6 +624,7 @@ pub(crate) fn load(path: &Path, options: &LoadOptions) -> Result<MeshData> {
             file_faces: scan.faces,
             file_unreferenced: scan.unreferenced,
             edited: false,
+            files,
         },
         warnings,
     })

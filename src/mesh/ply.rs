@@ -222,6 +222,7 @@ pub(crate) fn load(path: &Path) -> Result<MeshData> {
             file_faces,
             file_unreferenced: 0,
             edited: false,
+            files: vec![path.to_path_buf()],
         },
         warnings: vec![],
     })

@@ -27,6 +27,7 @@ fn finish(name: &str, positions: Vec<Vec3>, triangles: Vec<[u32; 3]>) -> Mesh {
             file_faces: f,
             file_unreferenced: 0,
             edited: false,
+            files: Vec::new(),
         },
         warnings: vec![],
     };

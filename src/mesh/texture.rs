@@ -110,6 +110,13 @@ pub(crate) struct TextureCache {
 }
 
 impl TextureCache {
+    /// The files decoded so far, each once, in path order.
+    pub fn paths(&self) -> Vec<PathBuf> {
+        let mut p: Vec<PathBuf> = self.decoded.keys().map(|(p, _)| p.clone()).collect();
+        p.dedup();
+        p
+    }
+
     /// Decode the image at `path` once; later calls return the same `Arc`.
     /// `referrer` is the file that named the texture, for the error message.
     pub fn load(

@@ -271,6 +271,7 @@ mod tests {
                 file_faces: 4,
                 file_unreferenced: 0,
                 edited: false,
+                files: Vec::new(),
             },
             warnings: vec![],
         }

@@ -13,16 +13,40 @@
 //!   `f32` values. Every file is written atomically.
 
 use std::fmt::Write;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use super::Mesh;
 use crate::error::Result;
 
-/// Write `mesh` to `path` (an `.obj`), with its `.mtl` and textures beside it.
+/// The stem of the output's file names (`lod` for `lod.obj`).
+fn stem_of(path: &Path) -> String {
+    path.file_stem()
+        .map_or_else(|| "mesh".to_string(), |s| s.to_string_lossy().into_owned())
+}
+
+/// Every file [`write`] writes for `mesh` at `path`: the OBJ, the MTL and each texture.
+pub fn planned_files(mesh: &Mesh, path: &Path) -> Vec<PathBuf> {
+    let (stem, dir) = (stem_of(path), crate::io::parent_dir(path));
+    let mut files = vec![path.to_path_buf(), dir.join(format!("{stem}.mtl"))];
+    for (i, m) in mesh.materials().iter().enumerate() {
+        let name = safe(&m.name, i);
+        for (tex, role) in [
+            (&m.base_color_texture, "basecolor"),
+            (&m.normal_texture, "normal"),
+        ] {
+            if tex.is_some() {
+                files.push(dir.join(format!("{stem}-{name}-{role}.png")));
+            }
+        }
+    }
+    files
+}
+
+/// Write `mesh` to `path` (an `.obj`), with its `.mtl` and textures beside it. Refuses (before
+/// writing anything) when one of those files is a file the mesh was loaded from.
 pub fn write(mesh: &Mesh, path: &Path) -> Result<()> {
-    let stem = path
-        .file_stem()
-        .map_or_else(|| "mesh".to_string(), |s| s.to_string_lossy().into_owned());
+    crate::io::check_not_inputs(&planned_files(mesh, path), &mesh.source().files)?;
+    let stem = stem_of(path);
     let dir = crate::io::parent_dir(path);
     let mut mtl = String::new();
     for (i, m) in mesh.materials().iter().enumerate() {

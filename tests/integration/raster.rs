@@ -163,6 +163,7 @@ fn quad_mesh() -> Mesh {
             file_faces: 2,
             file_unreferenced: 0,
             edited: false,
+            files: Vec::new(),
         },
         warnings: vec![],
     };

@@ -4,6 +4,8 @@
 //!
 //! - `goals`: simplification goals the simplifier cannot take (a chain that does not get coarser,
 //!   more triangles than the mesh has), which used to abort in meshoptimizer's assertion.
+//! - `outputs`: outputs that destroyed inputs or mixed runs (`-o` the input, `merge --out` a
+//!   shard, `out = ""`, stale heat maps, tampered shards, half-made merges), refused first.
 //! - `plan`: configs the gate cannot judge (a threshold on a metric not computed, `switch_m`
 //!   without distances, more `switch_m` values than LODs), refused before the first render.
 //! - `baseline`: gate baselines that hold nothing usable (empty, a header only, prose, a folder,
@@ -17,6 +19,8 @@
 //! - `files`: paths that are not regular files (a FIFO, `/dev/zero`, `/dev/urandom`, a symlink
 //!   to one, a folder) as a mesh, material library, texture, glTF buffer or image, image or
 //!   config, which used to block or read until memory ran out.
+//! - `messages`: messages that misled (a config's mesh path "relative to the current
+//!   directory"; a full stdout as "a lodeval bug"; a full stderr as a panic).
 //! - `numbers`: meshes beyond single precision (1e30, 1e-30, far from the origin) refused; what
 //!   is within the bounds scores with finite numbers only; NaN pixels refused; PSNR saturates.
 //! - `obj_text`: OBJ text that loaded wrong (a byte-order mark, `usemtl` of an undefined
@@ -28,8 +32,10 @@ mod distances;
 mod files;
 mod gltf;
 mod goals;
+mod messages;
 mod numbers;
 mod obj_text;
+mod outputs;
 mod plan;
 
 use std::path::{Path, PathBuf};
