@@ -212,6 +212,42 @@ pub const MESH_OFFSET: Bound<f64> = Bound {
     why: "single-precision positions farther out cannot hold the shape",
 };
 
+/// Memory a job is estimated to need, checked before it starts from its image sizes and view
+/// counts with the per-pixel costs below (peak-memory slopes measured on the reference machine,
+/// rounded up), so a job that cannot fit is refused at once instead of being killed hours in.
+pub const MEMORY_GIB: Bound<f64> = Bound {
+    min: 0.0,
+    max: 16.0,
+    unit: "GiB of memory",
+    why: "estimated before the job starts; lower the image size or the number of views",
+};
+
+/// Bytes per pixel of one image pair scored with every metric (FLIP, SSIM, PSNR, the VDP's band
+/// planes): measured 165 in `eval`, 90 in `diff`.
+pub const BYTES_PER_SCORED_PIXEL: u64 = 200;
+/// Bytes per pixel of each view's prepared reference, which `eval` keeps for all views of an
+/// asset while its LODs are scored: measured 16.
+pub const BYTES_PER_REFERENCE_PIXEL: u64 = 24;
+/// Bytes per pixel of each view the image-driven optimizer holds: measured 72.
+pub const BYTES_PER_OPTIMIZER_PIXEL: u64 = 96;
+/// Bytes per pixel of one render (any sample count: samples are resolved tile by tile):
+/// measured 28.
+pub const BYTES_PER_RENDERED_PIXEL: u64 = 40;
+
+/// `Ok` when a job estimated at `bytes` fits [`MEMORY_GIB`]; else "JOB would need about N GiB,
+/// outside …".
+pub fn check_memory(job: &str, bytes: u64) -> Result<(), String> {
+    let gib = bytes as f64 / (1u64 << 30) as f64;
+    match MEMORY_GIB.refuse(gib) {
+        None => Ok(()),
+        Some(_) => Err(format!(
+            "{job} would need about {:.1} GiB, {}",
+            gib,
+            MEMORY_GIB.outside()
+        )),
+    }
+}
+
 /// Largest mesh file read (OBJ, MTL, PLY, OFF, glTF, GLB and glTF buffers), bytes.
 pub const MESH_BYTES: u64 = 4 << 30;
 /// Largest image file read (textures, `diff` and golden images), bytes.
@@ -238,6 +274,12 @@ mod tests {
         assert_eq!(1024f64.show(), "1024");
         assert_eq!(5773503.27f64.show(), "5773503");
         assert_eq!(1e-6f64.show(), "1e-6");
+        assert!(check_memory("x", 1 << 30).is_ok());
+        let m = check_memory("eval at 16384²", 48 << 30).unwrap_err();
+        assert!(
+            m.contains("about 48.0 GiB") && m.contains("0 to 16 GiB"),
+            "{m}"
+        );
         let e = THREADS.check("--threads", 100_000).unwrap_err();
         assert!(
             e.contains("--threads 100000") && e.contains("1 to 1024 worker threads"),
@@ -260,7 +302,7 @@ mod tests {
             .filter_map(|l| l.strip_prefix("pub const "))
             .filter_map(|l| l.split(':').next())
             .collect();
-        assert!(names.len() >= 15, "{names:?}");
+        assert!(names.len() >= 20, "{names:?}");
         for name in names {
             assert!(
                 section.contains(&format!("`{name}`")),

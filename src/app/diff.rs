@@ -106,6 +106,12 @@ pub fn diff(
             "compare images of the same size",
         ));
     }
+    let pixels = (a.width() * a.height()) as u64;
+    crate::limits::check_memory(
+        &format!("scoring {}x{} pixels", a.width(), a.height()),
+        pixels * crate::limits::BYTES_PER_SCORED_PIXEL,
+    )
+    .map_err(Error::Usage)?;
     let viewing = &seen.viewing;
     let vdp = crate::metric::vdp::Vdp::checked(viewing, seen.display)?;
     let ppd = viewing.ppd();

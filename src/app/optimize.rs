@@ -32,6 +32,15 @@ pub fn optimize(
             job.out.display()
         )));
     }
+    let o = &job.options;
+    crate::limits::check_memory(
+        &format!(
+            "optimizing with {} views at {}x{} pixels",
+            o.views, o.size, o.size
+        ),
+        o.views as u64 * (o.size as u64).pow(2) * crate::limits::BYTES_PER_OPTIMIZER_PIXEL,
+    )
+    .map_err(Error::Usage)?;
     let original = std::sync::Arc::new(mesh::load(&job.original, &LoadOptions::default())?);
     let simplified = std::sync::Arc::new(mesh::load(&job.simplified, &LoadOptions::default())?);
     // Neither the mesh nor the energy log may replace a file either input was read from.

@@ -73,6 +73,12 @@ pub struct RenderReport {
 
 /// Run a render job.
 pub fn render(job: &RenderJob) -> Result<RenderReport> {
+    let (w, h) = (job.settings.width as u64, job.settings.height as u64);
+    crate::limits::check_memory(
+        &format!("rendering {w}x{h} pixels"),
+        w * h * crate::limits::BYTES_PER_RENDERED_PIXEL,
+    )
+    .map_err(Error::Usage)?;
     let mesh = Arc::new(mesh::load(&job.mesh, &job.load)?);
     let scene = RenderScene::of(mesh.clone());
     let aspect = job.settings.width as f32 / job.settings.height as f32;

@@ -662,6 +662,31 @@ impl Config {
                 ));
             }
         }
+        // Memory: one scored pair at the render size and at the distance search's largest
+        // probe, plus every view's prepared reference.
+        {
+            use crate::limits::{BYTES_PER_REFERENCE_PIXEL, BYTES_PER_SCORED_PIXEL};
+            let px = (self.render.size.0 as u64).pow(2);
+            let views = self.render.rig.0.count() as u64;
+            let probe = if self.distance.enabled {
+                ((self.distance.max_diameter_px.0 as f64 * 1.1).ceil() as u64 + 8).pow(2)
+            } else {
+                0
+            };
+            let bytes =
+                px.max(probe) * BYTES_PER_SCORED_PIXEL + views * px * BYTES_PER_REFERENCE_PIXEL;
+            let job = format!(
+                "a run of {views} views at {0}x{0} pixels",
+                self.render.size.0
+            );
+            if let Err(problem) = crate::limits::check_memory(&job, bytes) {
+                return Err(fail(
+                    "size",
+                    problem,
+                    "lower [render] size or the rig's views",
+                ));
+            }
+        }
         if self.images.contact_sheets {
             let views = self.render.rig.0.count().min(self.images.sheet_views) as u64;
             let side = self.render.size.0 as u64;

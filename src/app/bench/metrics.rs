@@ -25,6 +25,11 @@ pub struct MetricBenchRow {
 pub fn bench_metrics(reference: &Path, test: &Path, runs: usize) -> Result<Vec<MetricBenchRow>> {
     use crate::metric::{LinearImage, flip::Flip, mse, ssim};
     let (a, b) = (LinearImage::load(reference)?, LinearImage::load(test)?);
+    crate::limits::check_memory(
+        &format!("scoring {}x{} pixels", a.width(), a.height()),
+        (a.width() * a.height()) as u64 * crate::limits::BYTES_PER_SCORED_PIXEL,
+    )
+    .map_err(crate::error::Error::Usage)?;
     let runs = runs.max(1);
     let time = |f: &dyn Fn() -> Result<f64>| -> Result<f64> {
         f()?;

@@ -63,6 +63,11 @@ pub fn bench_raster(b: &RasterBench) -> Result<Vec<RasterBenchRow>> {
     crate::limits::VIEWS
         .check("--views", b.views as u64)
         .map_err(Error::Usage)?;
+    crate::limits::check_memory(
+        &format!("rendering {0}x{0} pixels", b.size),
+        (b.size as u64).pow(2) * crate::limits::BYTES_PER_RENDERED_PIXEL,
+    )
+    .map_err(Error::Usage)?;
     let mesh = Arc::new(crate::mesh::shapes::torus(b.rings, b.sides, 0.35));
     let scene = RenderScene::of(mesh.clone());
     let cameras = Rig::Fibonacci(b.views).cameras(&mesh, 1.0);

@@ -92,6 +92,21 @@ fn out_of_range_flags_are_refused_with_their_bound() {
         &["calibrate", "modelfest", "--ppd", "0.5"],
         &["pixels per degree"],
     );
+    // Jobs whose estimated memory is beyond the stated cap (src/limits.rs MEMORY_GIB).
+    refused(
+        &[
+            "optimize",
+            spot,
+            spot,
+            "-o",
+            "/nonexistent/x.obj",
+            "--views",
+            "10000",
+            "--size",
+            "4096",
+        ],
+        &["10000 views", "GiB of memory"],
+    );
 }
 
 #[test]
@@ -128,7 +143,7 @@ fn out_of_range_config_values_name_the_key_and_line() {
     let mesh = model("spot/spot_mtl.obj");
     for (section, seen) in [
         (
-            "[render]\nsize = 16384\n[images]\nsheet_views = 100\n",
+            "[render]\nsize = 4096\n[images]\nsheet_views = 100\n",
             "sheet_views",
         ),
         ("[render]\nrig = \"fibonacci:4000000000\"\n", "views"),
@@ -137,6 +152,11 @@ fn out_of_range_config_values_name_the_key_and_line() {
         ("geometry_samples = 2000000000\n", "geometry_samples"),
         ("[images]\nsheet_views = 0\n", "sheet_views"),
         ("[distance]\nviews = 100000\n", "views"),
+        ("[render]\nsize = 8192\n", "GiB of memory"),
+        (
+            "[render]\nsize = 2048\nrig = \"fibonacci:2000\"\n",
+            "2000 views",
+        ),
     ] {
         let config = write(
             d,
