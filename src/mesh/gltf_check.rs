@@ -1,6 +1,7 @@
 //! Structural checks of a glTF document before anything reads through it: the node hierarchy is
 //! a forest (glTF 2.0 §3.5.3: no cycles, at most one parent per node, scene roots are roots), and
-//! every accessor lies inside its buffer view and every buffer view inside its buffer (§3.6.2).
+//! every accessor lies inside its buffer view and every buffer view inside its buffer, with a
+//! stride of at least one element (§3.6.2).
 //!
 //! The `gltf` crate checks that indices are in range but not these: a node that is its own
 //! descendant made the scene walk loop forever while memory grew, and an accessor past its view's
@@ -162,10 +163,22 @@ fn check_accessors(path: &Path, root: &gltf::json::Root) -> Result<()> {
             continue; // the crate's validation names an unknown type
         };
         let element = (ty.multiplicity() * ct.0.size()) as u64;
-        let stride = view
-            .byte_stride
-            .map_or(element, |s| s.0 as u64)
-            .max(element);
+        // §3.6.2.4: a stride is at least one element (the reader would take overlapping,
+        // short slices: an assertion in the `gltf` crate).
+        if let Some(st) = view.byte_stride
+            && (st.0 as u64) < element
+        {
+            return Err(at(
+                path,
+                format!("buffer view {vi}"),
+                format!(
+                    "has byteStride {}, less than the {element} bytes of one element of accessor \
+                     {ai}",
+                    st.0
+                ),
+            ));
+        }
+        let stride = view.byte_stride.map_or(element, |st| st.0 as u64);
         let count = acc.count.0;
         let offset = acc.byte_offset.map_or(0, |o| o.0);
         let need = match count {

@@ -135,6 +135,11 @@ fn accessors_and_views_past_their_ends_are_named() {
         v["accessors"][0]["count"] = json!(u64::MAX / 4)
     });
     refused_by_info(&huge, &["accessor 0"]);
+    // A stride shorter than one element (the `gltf` crate asserted on the short slices).
+    let stride = square(d, "stride", |v| {
+        v["bufferViews"][0]["byteStride"] = json!(4)
+    });
+    refused_by_info(&stride, &["buffer view 0", "byteStride 4", "accessor 0"]);
     // A view that reaches past the buffer.
     let view = square(d, "view", |v| {
         v["bufferViews"][1]["byteLength"] = json!(4000)
