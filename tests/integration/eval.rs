@@ -2,11 +2,10 @@
 //! the gate (thresholds, broken LODs, baselines, switch distances), golden images, bad configs, and
 //! monotone scores and distances along the LOD chain of every shipped model.
 
-use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-use crate::common::{Run, lodeval, model};
+use crate::common::{Run, files, lodeval, model};
 
 /// Run the CLI with `CI` set or removed.
 fn lodeval_ci(args: &[&str], ci: bool) -> Run {
@@ -40,26 +39,6 @@ fn asset(name: &str, mesh: &Path, rest: &str) -> String {
         "[[asset]]\nname = \"{name}\"\nmesh = \"{}\"\n{rest}\n",
         mesh.display()
     )
-}
-
-/// Every file under `dir` (relative path → bytes).
-fn files(dir: &Path) -> BTreeMap<PathBuf, Vec<u8>> {
-    let mut out = BTreeMap::new();
-    let mut stack = vec![dir.to_path_buf()];
-    while let Some(d) = stack.pop() {
-        for e in std::fs::read_dir(&d).unwrap() {
-            let p = e.unwrap().path();
-            if p.is_dir() {
-                stack.push(p);
-            } else {
-                out.insert(
-                    p.strip_prefix(dir).unwrap().to_path_buf(),
-                    std::fs::read(&p).unwrap(),
-                );
-            }
-        }
-    }
-    out
 }
 
 fn assert_same_tree(a: &Path, b: &Path) {

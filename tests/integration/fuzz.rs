@@ -189,36 +189,14 @@ fn seeds_are_valid() {
 // strides and lengths from -1 to 2^64; keys removed). Loading must end — a hang fails the test
 // after 20 s instead of stalling the suite — with `Ok` or an input error, never a panic.
 
-/// A two-triangle square with a node tree, two buffer views and two accessors, buffer inline.
+/// The square of `hostile::gltf` (a node tree, two buffer views, two accessors), buffer inline.
 fn gltf_json_seed() -> serde_json::Value {
-    let mut bin = Vec::new();
-    [0f32, 0., 0., 1., 0., 0., 1., 1., 0., 0., 1., 0.]
-        .iter()
-        .for_each(|c| bin.extend_from_slice(&c.to_le_bytes()));
-    [0u16, 1, 2, 0, 2, 3]
-        .iter()
-        .for_each(|i| bin.extend_from_slice(&i.to_le_bytes()));
+    use crate::hostile::gltf::{square_bin, square_document};
     let uri = format!(
         "data:application/octet-stream;base64,{}",
-        base64_encode(&bin)
+        base64_encode(&square_bin())
     );
-    serde_json::json!({
-        "asset": {"version": "2.0"},
-        "scene": 0,
-        "scenes": [{"nodes": [0]}],
-        "nodes": [{"mesh": 0, "children": [1, 2]}, {"translation": [1, 0, 0]}, {"children": []}],
-        "meshes": [{"primitives": [{"attributes": {"POSITION": 0}, "indices": 1}]}],
-        "buffers": [{"uri": uri, "byteLength": bin.len()}],
-        "bufferViews": [
-            {"buffer": 0, "byteOffset": 0, "byteLength": 48},
-            {"buffer": 0, "byteOffset": 48, "byteLength": 12}
-        ],
-        "accessors": [
-            {"bufferView": 0, "componentType": 5126, "count": 4, "type": "VEC3",
-             "min": [0, 0, 0], "max": [1, 1, 0]},
-            {"bufferView": 1, "componentType": 5123, "count": 6, "type": "SCALAR"}
-        ]
-    })
+    square_document(&uri)
 }
 
 /// Standard base64 (the seed's inline buffer); a dozen lines rather than a dependency for a test.

@@ -11,9 +11,8 @@ use serde_json::{Value, json};
 use super::{assert_refused, scratch, write};
 use crate::common::lodeval_within;
 
-/// A two-triangle square in glTF JSON with its `.bin` beside it, edited by `edit` first. Node 0
-/// holds the mesh; nodes 1 and 2 are empty children of node 0 (so edits can make cycles).
-pub fn square(dir: &Path, name: &str, edit: impl FnOnce(&mut Value)) -> PathBuf {
+/// The square's buffer: four positions (f32 × 3) then six u16 indices.
+pub fn square_bin() -> Vec<u8> {
     let mut bin = Vec::new();
     for c in [0f32, 0., 0., 1., 0., 0., 1., 1., 0., 0., 1., 0.] {
         bin.extend_from_slice(&c.to_le_bytes());
@@ -21,13 +20,19 @@ pub fn square(dir: &Path, name: &str, edit: impl FnOnce(&mut Value)) -> PathBuf 
     for i in [0u16, 1, 2, 0, 2, 3] {
         bin.extend_from_slice(&i.to_le_bytes());
     }
-    let mut doc = json!({
+    bin
+}
+
+/// A two-triangle square as glTF JSON whose buffer is at `uri`. Node 0 holds the mesh; nodes 1
+/// and 2 are its children (node 1 moved), so edits can make cycles.
+pub fn square_document(uri: &str) -> Value {
+    json!({
         "asset": {"version": "2.0"},
         "scene": 0,
         "scenes": [{"nodes": [0]}],
-        "nodes": [{"mesh": 0, "children": [1, 2]}, {}, {}],
+        "nodes": [{"mesh": 0, "children": [1, 2]}, {"translation": [1, 0, 0]}, {"children": []}],
         "meshes": [{"primitives": [{"attributes": {"POSITION": 0}, "indices": 1}]}],
-        "buffers": [{"uri": format!("{name}.bin"), "byteLength": bin.len()}],
+        "buffers": [{"uri": uri, "byteLength": square_bin().len()}],
         "bufferViews": [
             {"buffer": 0, "byteOffset": 0, "byteLength": 48},
             {"buffer": 0, "byteOffset": 48, "byteLength": 12}
@@ -37,9 +42,14 @@ pub fn square(dir: &Path, name: &str, edit: impl FnOnce(&mut Value)) -> PathBuf 
              "min": [0, 0, 0], "max": [1, 1, 0]},
             {"bufferView": 1, "componentType": 5123, "count": 6, "type": "SCALAR"}
         ]
-    });
+    })
+}
+
+/// The square with its `.bin` beside it, edited by `edit` first.
+pub fn square(dir: &Path, name: &str, edit: impl FnOnce(&mut Value)) -> PathBuf {
+    let mut doc = square_document(&format!("{name}.bin"));
     edit(&mut doc);
-    std::fs::write(dir.join(format!("{name}.bin")), &bin).unwrap();
+    std::fs::write(dir.join(format!("{name}.bin")), square_bin()).unwrap();
     let path = dir.join(format!("{name}.gltf"));
     std::fs::write(&path, serde_json::to_string_pretty(&doc).unwrap()).unwrap();
     path

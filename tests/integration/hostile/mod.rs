@@ -30,7 +30,7 @@ mod baseline;
 mod bounds;
 mod distances;
 mod files;
-mod gltf;
+pub mod gltf;
 mod goals;
 mod messages;
 mod numbers;

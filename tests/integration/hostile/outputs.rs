@@ -7,7 +7,7 @@
 use std::path::{Path, PathBuf};
 
 use super::{assert_refused, scratch, write};
-use crate::common::{lodeval_within, model, simplify};
+use crate::common::{files, lodeval_within, model, simplify};
 
 /// A copy of the shipped Spot (OBJ, MTL, texture) in `dir`.
 fn spot_copy(dir: &Path) -> PathBuf {
@@ -16,24 +16,6 @@ fn spot_copy(dir: &Path) -> PathBuf {
         std::fs::copy(src.join(f), dir.join(f)).unwrap();
     }
     dir.join("spot_mtl.obj")
-}
-
-/// Every file of `dir` with its bytes, to show nothing changed.
-fn snapshot(dir: &Path) -> Vec<(PathBuf, Vec<u8>)> {
-    let mut out = Vec::new();
-    let mut stack = vec![dir.to_path_buf()];
-    while let Some(d) = stack.pop() {
-        for e in std::fs::read_dir(&d).unwrap() {
-            let p = e.unwrap().path();
-            if p.is_dir() {
-                stack.push(p);
-            } else {
-                out.push((p.clone(), std::fs::read(&p).unwrap()));
-            }
-        }
-    }
-    out.sort();
-    out
 }
 
 fn run(args: &[&std::ffi::OsStr]) -> crate::common::Run {
@@ -46,7 +28,7 @@ fn an_output_that_is_an_input_is_refused() {
     let d = tmp.path();
     let spot = spot_copy(d);
     std::os::unix::fs::symlink("spot_mtl.obj", d.join("link.obj")).unwrap();
-    let before = snapshot(d);
+    let before = files(d);
     // -o the input itself, a link to it, and an OBJ whose .mtl would replace the input's.
     for (out, culprit) in [
         ("spot_mtl.obj", "spot_mtl.obj"),
@@ -58,14 +40,14 @@ fn an_output_that_is_an_input_is_refused() {
     }
     // A chain whose second file is the input: refused before the first file is written.
     std::fs::copy(&spot, d.join("lod-r25.obj")).unwrap();
-    let before_chain = snapshot(d);
+    let before_chain = files(d);
     let r = simplify(
         &d.join("lod-r25.obj"),
         &d.join("lod.obj"),
         &["--chain", "0.5,0.25"],
     );
     assert_refused(&r, "chain", &["lod-r25.obj", "is an input"]);
-    assert_eq!(snapshot(d), before_chain, "the refused chain wrote a file");
+    assert_eq!(files(d), before_chain, "the refused chain wrote a file");
     std::fs::remove_file(d.join("lod-r25.obj")).unwrap();
     // render onto the mesh's texture; optimize onto the original.
     let r = run(&[
@@ -85,7 +67,7 @@ fn an_output_that_is_an_input_is_refused() {
         "10".as_ref(),
     ]);
     assert_refused(&r, "optimize", &["spot_mtl.obj", "is an input"]);
-    assert_eq!(snapshot(d), before, "an input changed");
+    assert_eq!(files(d), before, "an input changed");
 }
 
 /// A small eval config in `dir` with `extra` keys, writing to `out` (as written in the file).
@@ -112,10 +94,10 @@ fn an_output_folder_that_is_not_lodevals_is_refused() {
     assert_refused(&r, "out = \"\"", &["empty.toml", "line 1", "out is empty"]);
     // A folder holding someone else's files (here: the config itself) is refused untouched.
     let cfg = config(d, "here.toml", ".", "");
-    let before = snapshot(d);
+    let before = files(d);
     let r = run(&["eval".as_ref(), cfg.as_os_str()]);
     assert_refused(&r, "out = \".\"", &["did not write", "new or empty folder"]);
-    assert_eq!(snapshot(d), before);
+    assert_eq!(files(d), before);
     // A gate baseline inside what the run would clear is refused, and survives.
     let cfg = config(d, "ok.toml", "out", "");
     assert_eq!(
@@ -197,7 +179,7 @@ fn merge_verifies_what_the_shards_wrote_and_never_overwrites_them() {
         ])
     };
     // Into a shard folder, inside one, or around both: refused, shards untouched.
-    let before = snapshot(d);
+    let before = files(d);
     for out in [shard(0), shard(1).join("sub"), d.to_path_buf()] {
         let r = merge(&out);
         assert_refused(
@@ -206,7 +188,7 @@ fn merge_verifies_what_the_shards_wrote_and_never_overwrites_them() {
             &["shard folder", "new folder"],
         );
     }
-    assert_eq!(snapshot(d), before);
+    assert_eq!(files(d), before);
     assert_eq!(merge(&d.join("m")).code, 0);
     // Tampered shards: an edited row, a duplicated row, a deleted heat map, a stray file. Each
     // is refused and leaves no merged folder behind.
