@@ -24,7 +24,7 @@ fn stem_of(path: &Path) -> String {
         .map_or_else(|| "mesh".to_string(), |s| s.to_string_lossy().into_owned())
 }
 
-/// Every file [`write`] writes for `mesh` at `path`: the OBJ, the MTL and each texture.
+/// Every file [`write()`] writes for `mesh` at `path`: the OBJ, the MTL and each texture.
 pub fn planned_files(mesh: &Mesh, path: &Path) -> Vec<PathBuf> {
     let (stem, dir) = (stem_of(path), crate::io::parent_dir(path));
     let mut files = vec![path.to_path_buf(), dir.join(format!("{stem}.mtl"))];
