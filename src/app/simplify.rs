@@ -20,6 +20,8 @@ pub struct SimplifyJob {
     pub goals: Vec<crate::simplify::Goal>,
     /// Write one file per goal with a suffix (a chain) rather than `out` itself.
     pub chain: bool,
+    /// Metres per model unit (menzel-guthe's distance goals).
+    pub meters_per_unit: f64,
 }
 
 /// One written LOD.
@@ -35,6 +37,31 @@ pub struct SimplifyRow {
     pub simplifier_error: Option<f64>,
     /// Seconds for the whole chain (wall clock; reporting only).
     pub seconds: f64,
+    /// Menzel–Guthe's figures for this LOD and its run.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub menzel_guthe: Option<MenzelGutheRow>,
+}
+
+/// What a Menzel–Guthe run did, reported with each of its LODs.
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct MenzelGutheRow {
+    /// The LOD is imperceptible from this distance on, metres.
+    pub distance_m: f64,
+    /// Collapses made to reach this LOD.
+    pub collapses: usize,
+    /// The whole run's counts (applied collapses, perception tests, postponements, Hausdorff
+    /// tests).
+    #[serde(flatten)]
+    pub run: crate::simplify::menzel_guthe::Counts,
+}
+
+/// What `simplify` wrote and what the user should know.
+#[derive(Debug, Clone)]
+pub struct SimplifyReport {
+    /// One row per LOD written.
+    pub rows: Vec<SimplifyRow>,
+    /// Notes for the user (stderr).
+    pub warnings: Vec<String>,
 }
 
 /// Check that `out` is an OBJ path, then load `input` (the simplifiers' common start).
@@ -52,7 +79,7 @@ fn load_for_lod(input: &Path, out: &Path) -> Result<Mesh> {
 pub fn simplify(
     job: &SimplifyJob,
     progress: &dyn crate::progress::Progress,
-) -> Result<Vec<SimplifyRow>> {
+) -> Result<SimplifyReport> {
     let mesh = load_for_lod(&job.mesh, &job.out)?;
     // Every file of the chain is checked before the simplifier runs: none may be an input.
     let files: Vec<PathBuf> = job.goals.iter().map(|g| lod_file(job, g)).collect();
@@ -71,22 +98,55 @@ pub fn simplify(
             job.method.name()
         ),
     );
-    let lods = crate::simplify::chain(&mesh, job.method, &job.goals);
+    let mut warnings = Vec::new();
+    let lods = if job.method == crate::simplify::Method::MenzelGuthe {
+        if mesh.materials().iter().all(|m| m.name == "default") {
+            warnings.push(format!(
+                "{}: no material information: menzel-guthe shades it with the default material \
+                 (light grey, faint highlight)",
+                job.mesh.display()
+            ));
+        }
+        let options = crate::simplify::menzel_guthe::Options {
+            meters_per_unit: job.meters_per_unit,
+            ..crate::simplify::menzel_guthe::Options::DEFAULT
+        };
+        let goals = crate::simplify::menzel_guthe_goals(mesh.triangle_count(), &job.goals);
+        crate::simplify::check_goals(mesh.triangle_count(), &job.goals).and_then(|()| {
+            let s = crate::simplify::menzel_guthe::simplify(&mesh, &goals, &options)?;
+            let counts = s.counts;
+            Ok(s.lods
+                .into_iter()
+                .map(|l| {
+                    let row = MenzelGutheRow {
+                        distance_m: l.distance_m,
+                        collapses: l.collapses,
+                        run: counts,
+                    };
+                    (l.mesh, None, Some(row))
+                })
+                .collect::<Vec<_>>())
+        })
+    } else {
+        crate::simplify::chain(&mesh, job.method, &job.goals)
+            .map(|ls| ls.into_iter().map(|l| (l.mesh, l.error, None)).collect())
+    };
     progress.finish();
     let lods = lods?;
     let seconds = start.elapsed().as_secs_f64();
     let mut rows = Vec::new();
-    for (lod, file) in lods.iter().zip(files) {
-        crate::mesh::write_obj::write(&lod.mesh, &file)?;
+    for ((lod, error, mg), file) in lods.iter().zip(files) {
+        crate::mesh::write_obj::write(lod, &file)?;
         rows.push(SimplifyRow {
             file,
-            triangles: lod.mesh.triangle_count(),
-            ratio: lod.mesh.triangle_count() as f64 / mesh.triangle_count() as f64,
-            simplifier_error: lod.error,
+            triangles: lod.triangle_count(),
+            ratio: lod.triangle_count() as f64 / mesh.triangle_count() as f64,
+            simplifier_error: *error,
             seconds,
+            menzel_guthe: mg.clone(),
         });
     }
-    Ok(rows)
+    Ok(SimplifyReport { rows, warnings })
 }
 
 /// The file a LOD of `goal` goes to: `out` itself, or in a chain `STEM-r50.obj`, `STEM-t1000.obj`,
@@ -105,6 +165,7 @@ fn lod_file(job: &SimplifyJob, goal: &crate::simplify::Goal) -> PathBuf {
         }
         crate::simplify::Goal::Triangles(t) => format!("t{t}"),
         crate::simplify::Goal::Error(e) => format!("e{e}"),
+        crate::simplify::Goal::Distance(d) => format!("d{d}"),
     };
     job.out.with_file_name(format!("{stem}-{suffix}.obj"))
 }
@@ -186,5 +247,6 @@ pub fn simplify_williams(job: &WilliamsJob) -> Result<Vec<SimplifyRow>> {
         ratio: lod.triangle_count() as f64 / mesh.triangle_count() as f64,
         simplifier_error: None,
         seconds,
+        menzel_guthe: None,
     }])
 }

@@ -28,6 +28,10 @@ pub(crate) enum MethodArg {
     MeshoptUpdate,
     /// Williams et al. 2003: perceptual, view-dependent, to a --budget or --distance.
     Williams,
+    /// Menzel & Guthe 2010: each collapse tested for imperceptibility in vertex space, to a
+    /// --distance, --error, --ratio or --triangles.
+    #[value(name = "menzel-guthe")]
+    MenzelGuthe,
 }
 
 impl MethodArg {
@@ -39,6 +43,7 @@ impl MethodArg {
             MethodArg::Meshopt => Method::Meshopt,
             MethodArg::MeshoptUpdate => Method::MeshoptUpdate,
             MethodArg::Williams => Method::Williams,
+            MethodArg::MenzelGuthe => Method::MenzelGuthe,
         }
     }
 }
@@ -88,10 +93,14 @@ pub(crate) struct SimplifyArgs {
     /// williams: triangle budget.
     #[arg(long, conflicts_with_all = ["ratio", "triangles", "error", "chain", "distance"])]
     pub(crate) budget: Option<usize>,
-    /// williams: instead of a budget, refine until the LOD is imperceptible from this viewing
-    /// distance in metres (the display and viewer of the default viewing conditions).
+    /// williams and menzel-guthe: the LOD is imperceptible from this viewing distance on, in
+    /// metres (the display and viewer of the default viewing conditions; --meters-per-unit
+    /// scales the model).
     #[arg(long, conflicts_with_all = ["ratio", "triangles", "error", "chain"])]
     pub(crate) distance: Option<f64>,
+    /// menzel-guthe: metres per model unit (what --distance is measured against).
+    #[arg(long, default_value_t = 1.0)]
+    pub(crate) meters_per_unit: f64,
     /// williams: the camera, as EX,EY,EZ (looking at the model's centre, default field of view) or
     /// EX,EY,EZ,TX,TY,TZ. Default: view 0 of the default rig at the default framing.
     #[arg(long, value_delimiter = ',', num_args = 1, conflicts_with_all = ["view", "all_views"])]
@@ -163,7 +172,14 @@ pub(crate) fn run(a: SimplifyArgs, quiet: bool) -> Result<(), Error> {
             Err(Error::Usage(format!("{what} {r}: use a value in (0, 1]")))
         }
     };
-    let goals: Vec<Goal> = if !a.chain.is_empty() {
+    if method != Method::MenzelGuthe && a.distance.is_some() {
+        return Err(Error::Usage(
+            "--distance is for --method williams or menzel-guthe".into(),
+        ));
+    }
+    let goals: Vec<Goal> = if let Some(d) = a.distance {
+        vec![Goal::Distance(d)]
+    } else if !a.chain.is_empty() {
         a.chain
             .iter()
             .map(|&r| unit(r, "--chain").map(Goal::Ratio))
@@ -173,10 +189,17 @@ pub(crate) fn run(a: SimplifyArgs, quiet: bool) -> Result<(), Error> {
     } else if let Some(t) = a.triangles {
         vec![Goal::Triangles(t.max(1))]
     } else if let Some(e) = a.error {
+        if method == Method::MenzelGuthe && !(e > 0.0 && e < 1.0) {
+            return Err(Error::Usage(format!(
+                "--error {e}: give a fraction of the bounding-box diagonal in (0, 1)"
+            )));
+        }
         vec![Goal::Error(unit(e, "--error")?)]
     } else {
         return Err(Error::Usage(
-            "give --ratio R, --triangles N, --error E or --chain R1,R2,...".into(),
+            "give --ratio R, --triangles N, --error E, --chain R1,R2,... or (menzel-guthe) \
+         --distance METRES"
+                .into(),
         ));
     };
     let job = lodeval::app::SimplifyJob {
@@ -185,21 +208,40 @@ pub(crate) fn run(a: SimplifyArgs, quiet: bool) -> Result<(), Error> {
         method,
         chain: !a.chain.is_empty(),
         goals: goals.clone(),
+        meters_per_unit: a.meters_per_unit,
     };
-    let rows = lodeval::app::simplify(&job, &Reporter::new(quiet))?;
+    let report = lodeval::app::simplify(&job, &Reporter::new(quiet))?;
+    super::print::warnings(&report.warnings);
+    let rows = report.rows;
     warn_short_of_goals(&rows, &goals, method.name());
     if a.json {
         return emit_json(&rows);
     }
     let mut text = String::new();
     for r in &rows {
+        let error = match &r.menzel_guthe {
+            Some(mg) => format!(
+                "imperceptible from {:.3} m ({} collapses; run: {} applied, {} perception tests, \
+                 {} + {} postponed, {} Hausdorff tests)",
+                mg.distance_m,
+                mg.collapses,
+                mg.run.applied,
+                mg.run.perception_tests,
+                mg.run.postponed_perceptual,
+                mg.run.postponed_geometric,
+                mg.run.hausdorff_tests
+            ),
+            None => format!(
+                "simplifier error {}",
+                r.simplifier_error
+                    .map_or_else(|| "-".to_string(), |e| format!("{e:.3e}"))
+            ),
+        };
         text.push_str(&format!(
-            "{}  {} triangles ({:.4} of the input), simplifier error {}\n",
+            "{}  {} triangles ({:.4} of the input), {error}\n",
             r.file.display(),
             r.triangles,
             r.ratio,
-            r.simplifier_error
-                .map_or_else(|| "-".to_string(), |e| format!("{e:.3e}"))
         ));
     }
     emit(&text)
@@ -218,7 +260,7 @@ fn warn_short_of_goals(
         let target = match *g {
             Goal::Ratio(x) => (x * input).round(),
             Goal::Triangles(n) => n as f64,
-            Goal::Error(_) => continue,
+            Goal::Error(_) | Goal::Distance(_) => continue,
         };
         if r.triangles as f64 > 1.05 * target + 2.0 {
             note!(

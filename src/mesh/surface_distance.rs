@@ -86,10 +86,17 @@ impl ClosestPoint {
 
     /// Distance from `q` to the surface.
     pub fn distance(&self, q: Vec3) -> f32 {
+        self.closest(q).map_or(f32::INFINITY, |(_, d)| d)
+    }
+
+    /// The triangle nearest to `q` (its index in the mesh's triangle list) and the distance to
+    /// it; `None` for a mesh without triangles.
+    pub fn closest(&self, q: Vec3) -> Option<(u32, f32)> {
         let mut best = f32::INFINITY;
+        let mut best_tri = None;
         let nodes = &self.bvh.nodes;
         if nodes.is_empty() {
-            return best;
+            return None;
         }
         let mut stack: Vec<u32> = Vec::with_capacity(64);
         stack.push(0);
@@ -102,8 +109,11 @@ impl ClosestPoint {
                 let first = node.first_index as usize;
                 for &prim in &self.bvh.primitive_indices[first..first + node.prim_count as usize] {
                     let d2 = point_triangle_distance2(q, &self.tris[prim as usize]);
-                    if d2 < best * best {
+                    // Ties go to the lower triangle index, whatever order the tree visits them.
+                    if d2 < best * best || (d2 == best * best && best_tri.is_some_and(|t| prim < t))
+                    {
                         best = d2.sqrt();
+                        best_tri = Some(prim);
                     }
                 }
             } else {
@@ -128,7 +138,12 @@ impl ClosestPoint {
                 }
             }
         }
-        best
+        best_tri.map(|t| (t, best))
+    }
+
+    /// The corners of triangle `t`.
+    pub fn triangle(&self, t: u32) -> &[Vec3; 3] {
+        &self.tris[t as usize]
     }
 
     /// Brute force over every triangle (for tests).
@@ -148,40 +163,85 @@ fn box_distance2(q: Vec3, min: Vec3, max: Vec3) -> f32 {
 
 /// Squared distance from `p` to triangle `t` (Ericson, Real-Time Collision Detection §5.1.5).
 pub fn point_triangle_distance2(p: Vec3, t: &[Vec3; 3]) -> f32 {
-    let [a, b, c] = *t;
-    let (ab, ac, ap) = (b - a, c - a, p - a);
-    let (d1, d2) = (ab.dot(ap), ac.dot(ap));
-    if d1 <= 0.0 && d2 <= 0.0 {
-        return ap.length_squared();
+    (p - Nearest::of(p, t).point(t)).length_squared()
+}
+
+/// The barycentric coordinates (of `t`'s corners) of the point of triangle `t` nearest to `p`.
+pub fn nearest_barycentric(p: Vec3, t: &[Vec3; 3]) -> Vec3 {
+    match Nearest::of(p, t) {
+        Nearest::A => Vec3::X,
+        Nearest::B => Vec3::Y,
+        Nearest::C => Vec3::Z,
+        Nearest::Ab(v) => Vec3::new(1.0 - v, v, 0.0),
+        Nearest::Ac(w) => Vec3::new(1.0 - w, 0.0, w),
+        Nearest::Bc(w) => Vec3::new(0.0, 1.0 - w, w),
+        Nearest::Face(v, w) => Vec3::new(1.0 - v - w, v, w),
     }
-    let bp = p - b;
-    let (d3, d4) = (ab.dot(bp), ac.dot(bp));
-    if d3 >= 0.0 && d4 <= d3 {
-        return bp.length_squared();
+}
+
+/// Which feature of a triangle (a, b, c) is nearest to a point, with its parameters.
+enum Nearest {
+    A,
+    B,
+    C,
+    /// a + (b − a)·v.
+    Ab(f32),
+    /// a + (c − a)·w.
+    Ac(f32),
+    /// b + (c − b)·w.
+    Bc(f32),
+    /// a + (b − a)·v + (c − a)·w.
+    Face(f32, f32),
+}
+
+impl Nearest {
+    /// Ericson's region tests (§5.1.5).
+    fn of(p: Vec3, t: &[Vec3; 3]) -> Nearest {
+        let [a, b, c] = *t;
+        let (ab, ac, ap) = (b - a, c - a, p - a);
+        let (d1, d2) = (ab.dot(ap), ac.dot(ap));
+        if d1 <= 0.0 && d2 <= 0.0 {
+            return Nearest::A;
+        }
+        let bp = p - b;
+        let (d3, d4) = (ab.dot(bp), ac.dot(bp));
+        if d3 >= 0.0 && d4 <= d3 {
+            return Nearest::B;
+        }
+        let vc = d1 * d4 - d3 * d2;
+        if vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0 {
+            return Nearest::Ab(d1 / (d1 - d3));
+        }
+        let cp = p - c;
+        let (d5, d6) = (ab.dot(cp), ac.dot(cp));
+        if d6 >= 0.0 && d5 <= d6 {
+            return Nearest::C;
+        }
+        let vb = d5 * d2 - d1 * d6;
+        if vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0 {
+            return Nearest::Ac(d2 / (d2 - d6));
+        }
+        let va = d3 * d6 - d5 * d4;
+        if va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0 {
+            return Nearest::Bc((d4 - d3) / ((d4 - d3) + (d5 - d6)));
+        }
+        let denom = 1.0 / (va + vb + vc);
+        Nearest::Face(vb * denom, vc * denom)
     }
-    let vc = d1 * d4 - d3 * d2;
-    if vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0 {
-        let v = d1 / (d1 - d3);
-        return (p - (a + ab * v)).length_squared();
+
+    /// The nearest point, computed as the region test's formula gives it.
+    fn point(&self, t: &[Vec3; 3]) -> Vec3 {
+        let [a, b, c] = *t;
+        match *self {
+            Nearest::A => a,
+            Nearest::B => b,
+            Nearest::C => c,
+            Nearest::Ab(v) => a + (b - a) * v,
+            Nearest::Ac(w) => a + (c - a) * w,
+            Nearest::Bc(w) => b + (c - b) * w,
+            Nearest::Face(v, w) => a + (b - a) * v + (c - a) * w,
+        }
     }
-    let cp = p - c;
-    let (d5, d6) = (ab.dot(cp), ac.dot(cp));
-    if d6 >= 0.0 && d5 <= d6 {
-        return cp.length_squared();
-    }
-    let vb = d5 * d2 - d1 * d6;
-    if vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0 {
-        let w = d2 / (d2 - d6);
-        return (p - (a + ac * w)).length_squared();
-    }
-    let va = d3 * d6 - d5 * d4;
-    if va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0 {
-        let w = (d4 - d3) / ((d4 - d3) + (d5 - d6));
-        return (p - (b + (c - b) * w)).length_squared();
-    }
-    let denom = 1.0 / (va + vb + vc);
-    let (v, w) = (vb * denom, vc * denom);
-    (p - (a + ab * v + ac * w)).length_squared()
 }
 
 /// Deterministic surface samples of `mesh`: its vertices plus about `face_samples` points spread

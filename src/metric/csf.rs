@@ -123,20 +123,32 @@ impl DalyCsf {
     }
 }
 
+/// Menzel–Guthe Table 1: (weight w_i, spread σ_i in cycles per degree) of the Gaussians whose sum
+/// fits the Burbeck–Kelly achromatic CSF.
+pub const BURBECK_KELLY_ACHROMATIC: [(f64, f64); 3] =
+    [(1.98488, 9.45161), (1.06781, 7.07609), (-1.18094, 3.14760)];
+/// The same for the chromatic CSF.
+pub const BURBECK_KELLY_CHROMATIC: [(f64, f64); 2] = [(0.27519, 7.00112), (0.24116, 3.78524)];
+
+/// A sum of Gaussians Σ w_i·exp(−f²/σ_i²) and its derivative at `f`.
+pub fn gaussian_sum(terms: &[(f64, f64)], f: f64) -> (f64, f64) {
+    let (mut c, mut d) = (0.0, 0.0);
+    for &(w, sigma) in terms {
+        let g = w * (-(f * f) / (sigma * sigma)).exp();
+        c += g;
+        d += g * (-2.0 * f / (sigma * sigma));
+    }
+    (c, d)
+}
+
 /// Menzel–Guthe Table 1 fit of the Burbeck–Kelly achromatic CSF.
 pub fn burbeck_kelly_achromatic(f: f64) -> f64 {
-    [(1.98488, 9.45161), (1.06781, 7.07609), (-1.18094, 3.14760)]
-        .iter()
-        .map(|&(w, s): &(f64, f64)| w * (-(f * f) / (s * s)).exp())
-        .sum()
+    gaussian_sum(&BURBECK_KELLY_ACHROMATIC, f).0
 }
 
 /// Menzel–Guthe Table 1 fit of the Burbeck–Kelly chromatic CSF.
 pub fn burbeck_kelly_chromatic(f: f64) -> f64 {
-    [(0.27519, 7.00112), (0.24116, 3.78524)]
-        .iter()
-        .map(|&(w, s): &(f64, f64)| w * (-(f * f) / (s * s)).exp())
-        .sum()
+    gaussian_sum(&BURBECK_KELLY_CHROMATIC, f).0
 }
 
 /// A CSF sampled into a table and clamped to its peak below the peak frequency, so that it is

@@ -32,7 +32,7 @@ mod recycle;
 mod resolve;
 mod scene;
 mod setup;
-mod shade;
+pub(crate) mod shade;
 mod tangents;
 mod texture;
 

@@ -7,6 +7,7 @@
 pub mod attributes;
 pub mod cluster;
 pub mod lindstrom_turk;
+pub mod menzel_guthe;
 pub mod meshopt;
 pub mod qem;
 mod queue;
@@ -48,6 +49,10 @@ pub enum Method {
     /// Williams et al. 2003 perceptual budget refinement: one static LOD for the 20 views of the
     /// default rig (each node keyed by its worst view), Gouraud shading, default viewing.
     Williams,
+    /// Menzel & Guthe 2010: collapses tested in vertex space for imperceptibility, with the
+    /// distance beyond which each is invisible (`menzel_guthe/`).
+    #[serde(rename = "menzel-guthe")]
+    MenzelGuthe,
 }
 
 impl Method {
@@ -59,6 +64,7 @@ impl Method {
             Method::Meshopt => "meshopt",
             Method::MeshoptUpdate => "meshopt-update",
             Method::Williams => "williams",
+            Method::MenzelGuthe => "menzel-guthe",
         }
     }
 }
@@ -72,6 +78,8 @@ pub enum Goal {
     Triangles(usize),
     /// Error relative to the bounding-box diagonal (each method's own error measure).
     Error(f64),
+    /// Imperceptible from this viewing distance on, metres (menzel-guthe only).
+    Distance(f64),
 }
 
 impl std::fmt::Display for Goal {
@@ -80,6 +88,7 @@ impl std::fmt::Display for Goal {
             Goal::Ratio(r) => write!(f, "ratio {r}"),
             Goal::Triangles(t) => write!(f, "{t} triangles"),
             Goal::Error(e) => write!(f, "error {e}"),
+            Goal::Distance(d) => write!(f, "distance {d} m"),
         }
     }
 }
@@ -175,7 +184,31 @@ pub(crate) fn flatten(lod: &Mesh) -> Result<Mesh> {
 /// consecutive goals of one kind must get strictly coarser (ratios and triangle counts
 /// decreasing, errors increasing), since each LOD of a chain is simpler than the one before.
 pub fn chain(mesh: &Mesh, method: Method, goals: &[Goal]) -> Result<Vec<Lod>> {
+    chain_scaled(mesh, method, goals, 1.0)
+}
+
+/// [`chain`] for a mesh of `meters_per_unit` metres per model unit (what distance goals are
+/// measured in).
+pub fn chain_scaled(
+    mesh: &Mesh,
+    method: Method,
+    goals: &[Goal],
+    meters_per_unit: f64,
+) -> Result<Vec<Lod>> {
     check_goals(mesh.triangle_count(), goals)?;
+    if method != Method::MenzelGuthe
+        && let Some(d) = goals.iter().find(|g| matches!(g, Goal::Distance(_)))
+    {
+        return Err(Error::Usage(format!(
+            "{} takes ratio, triangle or error goals, not a {d}; a distance goal is for \
+             menzel-guthe",
+            method.name()
+        )));
+    }
+    if method == Method::MenzelGuthe {
+        // Its own weld and attributes: the simplifier keeps seams and flat shading as they are.
+        return menzel_guthe_chain(mesh, goals, meters_per_unit);
+    }
     if let Some((welded, flat)) = normal_only_seams(mesh) {
         let lods = chain_of(&welded, method, goals)?;
         return lods
@@ -195,6 +228,11 @@ pub fn chain(mesh: &Mesh, method: Method, goals: &[Goal]) -> Result<Vec<Lod>> {
 pub fn check_goals(triangles: usize, goals: &[Goal]) -> Result<()> {
     for g in goals {
         match *g {
+            Goal::Distance(d) if !(d.is_finite() && d > 0.0) => {
+                return Err(Error::Usage(format!(
+                    "distance {d}: give a viewing distance in metres above 0"
+                )));
+            }
             Goal::Ratio(r) | Goal::Error(r) if !(r.is_finite() && r > 0.0 && r <= 1.0) => {
                 return Err(Error::Usage(format!(
                     "goal {r} is outside (0, 1]: ratios and relative errors are fractions"
@@ -214,6 +252,7 @@ pub fn check_goals(triangles: usize, goals: &[Goal]) -> Result<()> {
             (Goal::Ratio(a), Goal::Ratio(b)) => b < a,
             (Goal::Triangles(a), Goal::Triangles(b)) => b < a,
             (Goal::Error(a), Goal::Error(b)) => b > a,
+            (Goal::Distance(a), Goal::Distance(b)) => b > a,
             _ => true,
         };
         if !coarser {
@@ -228,14 +267,48 @@ pub fn check_goals(triangles: usize, goals: &[Goal]) -> Result<()> {
     Ok(())
 }
 
+/// `goals` for a mesh of `triangles` triangles in Menzel & Guthe's terms (ratios become
+/// triangle counts).
+pub fn menzel_guthe_goals(triangles: usize, goals: &[Goal]) -> Vec<menzel_guthe::Goal> {
+    goals
+        .iter()
+        .map(|&g| match g {
+            Goal::Ratio(r) => menzel_guthe::Goal::Triangles(
+                ((triangles as f64 * r).round() as usize).clamp(1, triangles),
+            ),
+            Goal::Triangles(t) => menzel_guthe::Goal::Triangles(t),
+            Goal::Error(e) => menzel_guthe::Goal::Error(e),
+            Goal::Distance(d) => menzel_guthe::Goal::Distance(d),
+        })
+        .collect()
+}
+
+/// Menzel & Guthe's chain: one progressive run to the coarsest goal, each LOD a prefix of it.
+fn menzel_guthe_chain(mesh: &Mesh, goals: &[Goal], meters_per_unit: f64) -> Result<Vec<Lod>> {
+    let mg = menzel_guthe_goals(mesh.triangle_count(), goals);
+    let options = menzel_guthe::Options {
+        meters_per_unit,
+        ..menzel_guthe::Options::DEFAULT
+    };
+    Ok(menzel_guthe::simplify(mesh, &mg, &options)?
+        .lods
+        .into_iter()
+        .map(|l| Lod {
+            mesh: l.mesh,
+            error: None,
+        })
+        .collect())
+}
+
 fn chain_of(mesh: &Mesh, method: Method, goals: &[Goal]) -> Result<Vec<Lod>> {
     let n = mesh.triangle_count();
     let tris = |g: Goal| match g {
         Goal::Ratio(r) => Some((n as f64 * r).round().max(1.0) as usize),
         Goal::Triangles(t) => Some(t),
-        Goal::Error(_) => None,
+        Goal::Error(_) | Goal::Distance(_) => None,
     };
     match method {
+        Method::MenzelGuthe => menzel_guthe_chain(mesh, goals, 1.0),
         Method::Meshopt | Method::MeshoptUpdate => {
             let mut out: Vec<Lod> = Vec::new();
             for &g in goals {

@@ -297,6 +297,24 @@ impl QemCost {
     }
 }
 
+impl QemCost {
+    /// The attribute values `b`'s wedges would take if `a` were collapsed into `b` at `p` —
+    /// what [`CollapseCost::collapsed`] would set — without changing anything (a perceptual test
+    /// looks at the LOD before the engine makes it). Empty without attribute quadrics, or when
+    /// the wedges cannot be paired (the collapse is illegal then).
+    pub fn proposed_wedges(&self, adj: &Adjacency, a: u32, b: u32, p: Vec3) -> WedgeValues {
+        let mut out = WedgeValues::new();
+        let (Some(attrs), Ok(map)) = (&self.attributes, adj.edge_wedge_map(a, b)) else {
+            return out;
+        };
+        let x = p.as_dvec3();
+        Self::for_groups(adj, b, &map, |wb, group| {
+            out.push((wb, attrs.optimal(group, x, &adj.wedges[wb as usize]).0));
+        });
+        out
+    }
+}
+
 impl CollapseCost for QemCost {
     fn evaluate(&self, adj: &Adjacency, a: u32, b: u32) -> (f64, Vec3, f64) {
         let (cost, p, q) = self.cost_at(adj, a, b);
@@ -401,8 +419,12 @@ impl Progressive {
     /// The structure after the shortest prefix of collapses that leaves at most `triangles`
     /// triangles (all collapses if none does).
     pub fn extract(&self, triangles: usize) -> Adjacency {
-        let n = self.prefix(triangles);
-        if n == self.collapses.len() {
+        self.replay(self.prefix(triangles))
+    }
+
+    /// The structure after the first `n` collapses (all of them when `n` is larger).
+    pub fn replay(&self, n: usize) -> Adjacency {
+        if n >= self.collapses.len() {
             return self.last.clone();
         }
         let mut adj = self.base.clone();

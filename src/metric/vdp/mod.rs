@@ -37,11 +37,11 @@
 //! Here the sum is over visual angle and its scale is the observers'.
 
 mod adaptation;
-mod bands;
+pub(crate) mod bands;
 mod display;
 mod filter;
 pub mod fitted;
-mod masking;
+pub(crate) mod masking;
 pub mod modelfest;
 mod pooling;
 mod psychometric;
