@@ -22,6 +22,9 @@ pub(crate) enum BenchTarget {
     Williams,
     /// The image-driven optimizer's evaluations per second on our QEM LOD of MESH....
     Optimize,
+    /// Menzel & Guthe's applied collapses per second on MESH..., beside our QEM's.
+    #[value(name = "menzel-guthe")]
+    MenzelGuthe,
 }
 
 #[derive(Args, Debug)]
@@ -40,8 +43,9 @@ pub(crate) struct BenchArgs {
     /// For `optimize`: energy evaluations per timed run.
     #[arg(long, default_value_t = 20_000, value_parser = count::<u64>(&lodeval::limits::EVALS))]
     pub(crate) evals: u64,
-    /// For `simplify`: target ratios, comma separated.
-    #[arg(long, value_delimiter = ',', default_value = "0.5,0.1,0.01")]
+    /// For `simplify`: target ratios, comma separated; for `menzel-guthe` the first is the goal
+    /// (default there 0.1).
+    #[arg(long, value_delimiter = ',')]
     pub(crate) ratios: Vec<f64>,
     /// For `simplify`: also a procedural bumpy sphere of 20·4^N triangles (0: none).
     #[arg(long, default_value_t = 0)]
@@ -108,7 +112,12 @@ pub(crate) fn run(a: BenchArgs) -> Result<(), Error> {
             "| mesh | triangles | MT nodes | hierarchy s | preprocess s | budget | frames | adapt ms median | p95 | max | first frame ms | nodes changed per frame (median) |\n|---|---|---|---|---|---|---|---|---|---|---|---|\n",
         );
         for (name, mesh) in named_meshes(&a.images)? {
-            for r in lodeval::app::bench::bench_williams(&mesh, &a.ratios, a.views)? {
+            let ratios = if a.ratios.is_empty() {
+                vec![0.5, 0.1, 0.01]
+            } else {
+                a.ratios.clone()
+            };
+            for r in lodeval::app::bench::bench_williams(&mesh, &ratios, a.views)? {
                 t.push_str(&format!(
                     "| {name} | {} | {} | {:.2} | {:.2} | {} | {} | {:.2} | {:.2} | {:.2} | {:.2} | {} |\n",
                     r.triangles,
@@ -161,6 +170,47 @@ pub(crate) fn run(a: BenchArgs) -> Result<(), Error> {
         }
         return emit(&t);
     }
+    if a.what == BenchTarget::MenzelGuthe {
+        let meshes = named_meshes(&a.images)?;
+        if meshes.is_empty() {
+            return Err(Error::Usage(
+                "lodeval bench menzel-guthe MESH...: give at least one mesh".into(),
+            ));
+        }
+        let ratio = a.ratios.first().copied().unwrap_or(0.1);
+        if !(ratio > 0.0 && ratio < 1.0) {
+            return Err(Error::Usage(format!(
+                "--ratios {ratio}: use a value in (0, 1)"
+            )));
+        }
+        let rows = lodeval::app::bench::bench_menzel_guthe(&meshes, ratio, a.runs)?;
+        if a.json {
+            return emit_json(&rows);
+        }
+        let mut t = String::from(
+            "| mesh | input triangles | LOD triangles | threads | runs | collapses | perception tests | Hausdorff tests | postponed | collapses/s best | median | worst | set-up s | QEM collapses/s |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n",
+        );
+        for r in &rows {
+            t.push_str(&format!(
+                "| {} | {} | {} | {} | {} | {} | {} | {} | {} | {:.0} | {:.0} | {:.0} | {:.2} | {:.0} |\n",
+                r.mesh,
+                r.input_triangles,
+                r.triangles,
+                r.threads,
+                r.runs,
+                r.collapses,
+                r.perception_tests,
+                r.hausdorff_tests,
+                r.postponed,
+                r.collapses_per_second,
+                r.median_collapses_per_second,
+                r.worst_collapses_per_second,
+                r.setup_seconds,
+                r.qem_collapses_per_second
+            ));
+        }
+        return emit(&t);
+    }
     if a.what == BenchTarget::Simplify {
         let mut meshes = named_meshes(&a.images)?;
         if a.bumpy > 0 {
@@ -173,7 +223,12 @@ pub(crate) fn run(a: BenchArgs) -> Result<(), Error> {
                 lodeval::mesh::shapes::bumpy_sphere(a.bumpy),
             ));
         }
-        let rows = lodeval::app::bench::bench_simplify(&meshes, &a.ratios, 1_000_000, a.runs)?;
+        let ratios = if a.ratios.is_empty() {
+            vec![0.5, 0.1, 0.01]
+        } else {
+            a.ratios.clone()
+        };
+        let rows = lodeval::app::bench::bench_simplify(&meshes, &ratios, 1_000_000, a.runs)?;
         if a.json {
             return emit_json(&rows);
         }

@@ -440,6 +440,10 @@ pub struct GenerateConfig {
     /// further LODs of the chain.
     #[serde(default)]
     pub errors: Vec<UnitInterval>,
+    /// Viewing distances in metres from which each LOD is imperceptible (menzel-guthe only), as
+    /// further LODs of the chain.
+    #[serde(default)]
+    pub distances: Vec<Positive>,
     /// Engine switch distances for the generated LODs, metres, in chain order.
     #[serde(default)]
     pub switch_m: Vec<Positive>,
@@ -725,31 +729,64 @@ impl Config {
             if let Some(g) = &a.generate
                 && g.ratios.is_empty()
                 && g.errors.is_empty()
+                && g.distances.is_empty()
             {
                 return Err(fail(
                     &quoted,
                     format!("asset '{}': generate has no ratios and no errors", a.name.0),
-                    "give `ratios = [0.5, 0.25]` and/or `errors = [0.01]`",
+                    "give `ratios = [0.5, 0.25]` and/or `errors = [0.01]` (menzel-guthe also \
+                     takes `distances = [5.0, 10.0]`, metres)",
+                ));
+            }
+            if let Some(g) = &a.generate
+                && !g.distances.is_empty()
+                && g.method != crate::simplify::Method::MenzelGuthe
+            {
+                return Err(fail(
+                    &quoted,
+                    format!(
+                        "asset '{}': generate method {} takes ratios and errors; distances are \
+                         for menzel-guthe",
+                        a.name.0,
+                        g.method.name()
+                    ),
+                    "use ratios or errors, or method = \"menzel-guthe\"",
                 ));
             }
             if let Some(g) = &a.generate {
-                let ratios = g.ratios.windows(2).find(|w| w[1].0 >= w[0].0);
-                let errors = g.errors.windows(2).find(|w| w[1].0 <= w[0].0);
-                if let Some((w, what)) = ratios
-                    .map(|w| (w, "ratios must decrease"))
-                    .or(errors.map(|w| (w, "errors must increase")))
-                {
+                // The first pair that does not get coarser: (first, then, what).
+                let pair = |v: Vec<f64>, coarser: fn(f64, f64) -> bool, what: &'static str| {
+                    v.windows(2)
+                        .find(|w| !coarser(w[0], w[1]))
+                        .map(|w| (w[0], w[1], what))
+                };
+                let bad = pair(
+                    g.ratios.iter().map(|r| r.0).collect(),
+                    |a, b| b < a,
+                    "ratios must decrease",
+                )
+                .or(pair(
+                    g.errors.iter().map(|e| e.0).collect(),
+                    |a, b| b > a,
+                    "errors must increase",
+                ))
+                .or(pair(
+                    g.distances.iter().map(|d| d.0).collect(),
+                    |a, b| b > a,
+                    "distances must increase",
+                ));
+                if let Some((first, then, what)) = bad {
                     return Err(fail(
                         &quoted,
                         format!(
-                            "asset '{}': generate {what} from one LOD to the next ({} then {}): \
-                             each LOD of the chain is simplified from the one before",
-                            a.name.0, w[0].0, w[1].0
+                            "asset '{}': generate {what} from one LOD to the next ({first} then \
+                             {then}): each LOD of the chain is simplified from the one before",
+                            a.name.0
                         ),
                         "order them from the finest LOD to the coarsest, e.g. ratios = [0.5, 0.25]",
                     ));
                 }
-                let lods = g.ratios.len() + g.errors.len();
+                let lods = g.ratios.len() + g.errors.len() + g.distances.len();
                 if g.switch_m.len() > lods {
                     return Err(fail(
                         &quoted,
@@ -821,6 +858,12 @@ impl Config {
                 out.push((
                     format!("{}-e{}", g.method.name(), e.0),
                     base + g.ratios.len() + k,
+                ));
+            }
+            for (k, d) in g.distances.iter().enumerate() {
+                out.push((
+                    format!("{}-d{}", g.method.name(), d.0),
+                    base + g.ratios.len() + g.errors.len() + k,
                 ));
             }
         }

@@ -38,6 +38,8 @@ pub enum GenTarget {
     Ratio(f64),
     /// Error relative to the bounding-box diagonal.
     Error(f64),
+    /// Viewing distance in metres (menzel-guthe).
+    Distance(f64),
 }
 
 impl GenTarget {
@@ -46,6 +48,7 @@ impl GenTarget {
         match self {
             GenTarget::Ratio(r) => Goal::Ratio(r),
             GenTarget::Error(e) => Goal::Error(e),
+            GenTarget::Distance(d) => Goal::Distance(d),
         }
     }
 }
@@ -206,7 +209,8 @@ impl Plan {
                     .ratios
                     .iter()
                     .map(|r| GenTarget::Ratio(r.0))
-                    .chain(g.errors.iter().map(|e| GenTarget::Error(e.0)));
+                    .chain(g.errors.iter().map(|e| GenTarget::Error(e.0)))
+                    .chain(g.distances.iter().map(|d| GenTarget::Distance(d.0)));
                 for (step, target) in targets.enumerate() {
                     lods.push(LodPlan {
                         name: names[a.lods.len() + step].0.clone(),

@@ -300,7 +300,7 @@ pub fn build_lods(
     let mut chain = match (last, generated.first()) {
         (Some(last), Some(&(method, _))) => {
             let goals: Vec<_> = generated[..=last].iter().map(|g| g.1.goal()).collect();
-            simplify::chain(original, method, &goals)?
+            simplify::chain_scaled(original, method, &goals, asset.meters_per_unit)?
                 .into_iter()
                 .map(Some)
                 .collect()
@@ -330,6 +330,9 @@ pub fn build_lods(
                     }
                     GenTarget::Error(e) => {
                         format!("{} error {e} (chain step {})", method.name(), step + 1)
+                    }
+                    GenTarget::Distance(d) => {
+                        format!("{} distance {d} m (chain step {})", method.name(), step + 1)
                     }
                 };
                 (l.mesh, what, l.error.map(round7))

@@ -10,6 +10,8 @@
 //! - `fuzz`: property-based mutation fuzzing of the OBJ, PLY, OFF and GLB paths.
 //! - `hostile`: hostile input by class (`hostile/mod.rs` lists them): refused with exit 2, never
 //!   an abort, a hang or a silently wrong pass.
+//! - `menzel_guthe`: `lodeval simplify --method menzel-guthe` (Menzel & Guthe 2010): goals and
+//!   distances, thread independence, the eval generator, bad requests.
 //! - `optimize`: `lodeval optimize` (Lindstrom–Turk): energy goes down, the vertex count stays,
 //!   the output is identical for 1, 2 and 8 threads; bad input exits 2.
 //! - `oracles`: metrics against reference implementations (FLIP: NVIDIA's; SSIM/PSNR: scikit-image).
@@ -29,6 +31,7 @@ mod fuzz;
 #[cfg(feature = "gpu")]
 mod gpu;
 mod hostile;
+mod menzel_guthe;
 mod models;
 mod optimize;
 mod oracles;

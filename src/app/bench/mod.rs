@@ -1,12 +1,14 @@
 //! `lodeval bench`: one file per benchmark; each returns rows the CLI prints as JSON or Markdown.
 //! Reporting only: no test asserts on a time.
 
+pub mod menzel_guthe;
 pub mod metrics;
 pub mod optimize;
 pub mod raster;
 pub mod simplify;
 pub mod williams;
 
+pub use menzel_guthe::*;
 pub use metrics::*;
 pub use optimize::*;
 pub use raster::*;

@@ -134,10 +134,16 @@ impl Sensitivity {
     /// The frequency on the falling branch where C = `q` (interpolated from the table; for
     /// q ≥ peak the peak frequency, below the table's floor its last entry).
     pub fn frequency_for(&self, q: f64) -> f64 {
-        if q >= self.peak {
+        self.frequency_for_ln(q.ln())
+    }
+
+    /// [`Sensitivity::frequency_for`] of ln q.
+    pub fn frequency_for_ln(&self, ln_q: f64) -> f64 {
+        let ln_peak = self.peak.ln();
+        if ln_q >= ln_peak {
             return self.peak_frequency;
         }
-        let x = (q / self.peak).ln() / FLOOR.ln() * (LEVELS - 1) as f64;
+        let x = (ln_q - ln_peak) / FLOOR.ln() * (LEVELS - 1) as f64;
         if x >= (LEVELS - 1) as f64 {
             return self.inverse[LEVELS - 1];
         }

@@ -65,12 +65,17 @@ impl Masking {
     /// δ·C ≥ t_d needs C ≥ 1/δ and C ≥ (m^s/δ)^(1/(1−s)). A cheap bound before the Newton
     /// iteration.
     pub fn least_sensitivity(&self, delta: f64, m: f64) -> f64 {
-        let unmasked = 1.0 / delta;
+        self.ln_least_sensitivity(delta.ln(), m).exp()
+    }
+
+    /// ln of [`Masking::least_sensitivity`], from ln δ (two logarithms, no power).
+    pub fn ln_least_sensitivity(&self, ln_delta: f64, m: f64) -> f64 {
+        let unmasked = -ln_delta;
         if !self.on || m <= 0.0 {
             return unmasked;
         }
         let s = SLOPE as f64;
-        unmasked.max((m.powf(s) / delta).powf(1.0 / (1.0 - s)))
+        unmasked.max((s * m.ln() - ln_delta) / (1.0 - s))
     }
 }
 

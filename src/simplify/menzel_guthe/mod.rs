@@ -20,6 +20,7 @@
 //! - `curvature.rs` — §4.3: principal curvatures and torsion;
 //! - `distance.rs` — §4.3 and Figure 4: frequencies, CSFs, the Newton iteration, silhouettes;
 //! - `masking.rs` — §4.4: the masker and Daly's threshold elevation;
+//! - `global.rs` — §4.4: global masking from renders of the whole model;
 //! - `hausdorff.rs` — §3.1: the geometric test against the original;
 //! - `perception.rs` — §4: one pair of points compared, the split distance.
 //!
@@ -34,6 +35,7 @@
 pub mod curvature;
 pub mod distance;
 pub mod field;
+pub mod global;
 pub mod hausdorff;
 pub mod masking;
 pub mod perception;
@@ -65,6 +67,8 @@ pub struct Options {
     pub display: Display,
     /// Daly's masking of differences by the signals themselves. Default value: true.
     pub masking: bool,
+    /// Global masking from renders of the whole model (§4.4). Default value: true.
+    pub global_masking: bool,
     /// Queue heads tested together (§5.1). Default value: 64.
     pub block: usize,
     /// Metres per model unit. Default value: 1.
@@ -81,6 +85,7 @@ impl Options {
         },
         display: Display::DEFAULT,
         masking: true,
+        global_masking: true,
         block: 64,
         meters_per_unit: 1.0,
     };
@@ -124,6 +129,9 @@ pub struct Simplified {
     pub counts: Counts,
     /// Seconds the run took (wall clock; reporting only).
     pub seconds: f64,
+    /// Of which before the collapse loop: the original's BVH, curvatures, global masking and
+    /// first queue.
+    pub setup_seconds: f64,
 }
 
 /// Check `goals` (exit 2 on nonsense): distances finite and above 0, errors in (0, 1),
@@ -155,6 +163,21 @@ pub fn check_goals(triangles: usize, goals: &[Goal]) -> Result<()> {
 /// Simplify `mesh` to every goal in one progressive run (to the coarsest).
 pub fn simplify(mesh: &Mesh, goals: &[Goal], options: &Options) -> Result<Simplified> {
     check_goals(mesh.triangle_count(), goals)?;
+    // A mesh split only by normals (flat shading) is simplified welded, and a flat original gets
+    // flat LODs, as with the other simplifiers (`simplify::normal_only_seams`).
+    if let Some((welded, flat)) = super::normal_only_seams(mesh) {
+        let mut s = simplify_welded(&welded, goals, options)?;
+        if flat {
+            for l in &mut s.lods {
+                l.mesh = super::flatten(&l.mesh)?;
+            }
+        }
+        return Ok(s);
+    }
+    simplify_welded(mesh, goals, options)
+}
+
+fn simplify_welded(mesh: &Mesh, goals: &[Goal], options: &Options) -> Result<Simplified> {
     if !(options.meters_per_unit.is_finite() && options.meters_per_unit > 0.0) {
         return Err(Error::Usage(format!(
             "--meters-per-unit {}: give a finite number above 0",
@@ -192,7 +215,20 @@ pub fn simplify(mesh: &Mesh, goals: &[Goal], options: &Options) -> Result<Simpli
     let engine = pipeline::Engine {
         block: options.block,
     };
-    let outcome = pipeline::run(mesh, &perception, &engine, stop, &|_, _| 0.0);
+    let global_start = std::time::Instant::now();
+    let global = if options.global_masking && options.masking {
+        global::GlobalMasking::measure(
+            &std::sync::Arc::new(mesh.clone()),
+            &options.lighting,
+            perception.response(),
+        )
+    } else {
+        global::GlobalMasking::none()
+    };
+    let global_seconds = global_start.elapsed().as_secs_f64();
+    let outcome = pipeline::run(mesh, &perception, &engine, stop, &|t, c, f| {
+        global.at(t, c, f)
+    });
     let lods = goals
         .iter()
         .map(|g| {
@@ -221,5 +257,6 @@ pub fn simplify(mesh: &Mesh, goals: &[Goal], options: &Options) -> Result<Simpli
         lods,
         counts: outcome.counts,
         seconds: start.elapsed().as_secs_f64(),
+        setup_seconds: global_seconds + outcome.seconds.0,
     })
 }

@@ -103,7 +103,7 @@ impl Perception {
     }
 
     /// D_max of original point `o` against simplified point `s`: `floor` is the frequency floor
-    /// (cycles per model unit), `global(f)` the global masker at surface frequency f. Distances
+    /// (cycles per model unit), `global(c, f)` the global masker of channel c at surface frequency f. Distances
     /// at or below `known` (a larger D_max found elsewhere) are not worked out.
     pub fn compare(
         &self,
@@ -111,10 +111,12 @@ impl Perception {
         s: &Point,
         floor: f32,
         known: f64,
-        global: &dyn Fn(f32) -> f32,
+        global: &dyn Fn(usize, f32) -> f32,
     ) -> Comparison {
         let (so, ss) = (self.spectrum(&o.inputs), self.spectrum(&s.inputs));
-        let tilt = o.frame.n.dot(s.frame.n).clamp(-1.0, 1.0).acos();
+        // The angle between the normals, 2·asin(|n₁ − n₂|/2): exact for small angles, where
+        // acos of their dot product rounds to 0 in single precision.
+        let tilt = 2.0 * (0.5 * (o.frame.n - s.frame.n).length()).min(1.0).asin();
         let twist = if so.turns > 1 || ss.turns > 1 {
             rotation::angles(&o.frame, &s.frame).z
         } else {
@@ -128,12 +130,13 @@ impl Perception {
         let zero = Slot::default();
         // Pass 1: every slot that could be seen farther than `known`, with its cheap bound.
         let mut candidates: Vec<Candidate> = Vec::new();
-        let mut consider = |delta: f32, masker: f32, f: f64, chromatic: bool, needed: f64| {
+        let ln_peaks = self.sensitivity.each_ref().map(|s| s.peak.ln());
+        let mut consider = |delta: f32, masker: f32, f: f64, chromatic: bool, ln_needed: f64| {
             let sens = &self.sensitivity[usize::from(chromatic)];
-            if needed > sens.peak {
+            if ln_needed > ln_peaks[usize::from(chromatic)] {
                 return; // masked at every frequency
             }
-            let bound = distance_for(f, sens.frequency_for(needed));
+            let bound = distance_for(f, sens.frequency_for_ln(ln_needed));
             if bound > known {
                 candidates.push(Candidate {
                     bound,
@@ -187,12 +190,13 @@ impl Perception {
                                 let f = surface_frequency(
                                     k_min, k_max, torsion, omega, w as f32, floor,
                                 ) as f64;
-                                let masker = masking::masker(global(f as f32), a, a);
+                                let masker = masking::masker(global(c, f as f32), a, a);
                                 let delta = a * factor;
                                 let needed = if masker > a {
-                                    self.masking.least_sensitivity(delta as f64, masker as f64)
+                                    self.masking
+                                        .ln_least_sensitivity((delta as f64).ln(), masker as f64)
                                 } else {
-                                    k / a as f64
+                                    (k / a as f64).ln()
                                 };
                                 consider(delta, masker, f, c > 0, needed);
                             }
@@ -235,9 +239,10 @@ impl Perception {
                             }
                             let f = surface_frequency(k_min, k_max, torsion, omega, w as f32, floor)
                                 as f64;
-                            let masker = masking::masker(global(f as f32), a1, a2);
-                            let needed =
-                                self.masking.least_sensitivity(delta as f64, masker as f64);
+                            let masker = masking::masker(global(c, f as f32), a1, a2);
+                            let needed = self
+                                .masking
+                                .ln_least_sensitivity((delta as f64).ln(), masker as f64);
                             consider(delta, masker, f, c > 0, needed);
                         }
                     }
@@ -321,7 +326,7 @@ mod tests {
     fn identical_points_differ_nowhere() {
         let p = perception();
         let a = point(Vec3::Z, 0.6, 32.0, 0.0);
-        let c = p.compare(&a, &a, 1.0, 0.0, &|_| 0.0);
+        let c = p.compare(&a, &a, 1.0, 0.0, &|_, _| 0.0);
         assert_eq!(c.distance, 0.0);
     }
 
@@ -332,15 +337,15 @@ mod tests {
         let small = point(Vec3::new(0.05, 0.0, 1.0).normalize(), 0.6, 32.0, 0.0);
         let large = point(Vec3::new(0.2, 0.0, 1.0).normalize(), 0.6, 32.0, 0.0);
         let (ds, dl) = (
-            p.compare(&a, &small, 10.0, 0.0, &|_| 0.0).distance,
-            p.compare(&a, &large, 10.0, 0.0, &|_| 0.0).distance,
+            p.compare(&a, &small, 10.0, 0.0, &|_, _| 0.0).distance,
+            p.compare(&a, &large, 10.0, 0.0, &|_, _| 0.0).distance,
         );
         // (Measured: 67 and 95 units at 10 cycles per unit; a tilt of 0.02 is masked by the
         // shading itself and invisible at any distance, as 0.005 is without masking only
         // beyond 48 units.)
         assert!(ds > 0.0 && dl > ds, "{ds} {dl}");
         // Global masking hides part of it.
-        let masked = p.compare(&a, &large, 10.0, 0.0, &|_| 500.0).distance;
+        let masked = p.compare(&a, &large, 10.0, 0.0, &|_, _| 500.0).distance;
         assert!(masked < dl, "{masked} vs {dl}");
     }
 }

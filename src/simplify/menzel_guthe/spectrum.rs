@@ -207,10 +207,13 @@ impl Basis {
     /// regularised fit of what varies around it.
     pub fn fit(&self, samples: &[f32]) -> [f32; COEFFICIENTS] {
         let mean = samples.iter().sum::<f32>() / samples.len().max(1) as f32;
+        let centred: Vec<f32> = samples.iter().map(|s| s - mean).collect();
         let mut c = [0.0f32; COEFFICIENTS];
         for (i, ci) in c.iter_mut().enumerate() {
-            let row = &self.pinv[i * self.samples..(i + 1) * self.samples];
-            *ci = row.iter().zip(samples).map(|(p, s)| p * (s - mean)).sum();
+            *ci = dot(
+                &self.pinv[i * self.samples..(i + 1) * self.samples],
+                &centred,
+            );
         }
         // Y₀₀ = 1/√(4π).
         c[0] += mean * (4.0 * std::f32::consts::PI).sqrt();
@@ -221,6 +224,21 @@ impl Basis {
     pub fn eval(c: &[f32; COEFFICIENTS], d: Vec3) -> f64 {
         real_sh(d).iter().zip(c).map(|(y, &ci)| y * ci as f64).sum()
     }
+}
+
+/// Σ aᵢ·bᵢ in eight lanes summed in a fixed order (the compiler vectorises it; a single running
+/// sum it may not reorder, and would not).
+fn dot(a: &[f32], b: &[f32]) -> f32 {
+    let mut lanes = [0.0f32; 8];
+    let (ca, cb) = (a.chunks_exact(8), b.chunks_exact(8));
+    let (ra, rb) = (ca.remainder(), cb.remainder());
+    for (x, y) in ca.zip(cb) {
+        for k in 0..8 {
+            lanes[k] += x[k] * y[k];
+        }
+    }
+    let tail: f32 = ra.iter().zip(rb).map(|(x, y)| x * y).sum();
+    lanes.iter().sum::<f32>() + tail
 }
 
 /// (G)⁻¹ of a symmetric positive-definite `n` × `n` matrix through its Cholesky factor.
