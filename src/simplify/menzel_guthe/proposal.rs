@@ -4,7 +4,7 @@
 //! perception test.
 //!
 //! Based on: Menzel & Guthe 2010, §3.1 (collapses "sorted into a priority queue ... estimated by
-//! the quadric error metric in [Hop99]") and §6 ("for each simplification operation three
+//! the quadric error metric in \[Hop99\]") and §6 ("for each simplification operation three
 //! vertices are checked").
 //!
 //! Decision: the three checked vertices are the merged vertex v̄ and the two vertices the collapse
@@ -45,6 +45,8 @@ pub struct Proposal {
     pub fan: Vec<Patch>,
     /// The merged vertex's neighbours after the collapse.
     pub ring: SmallVec<[Vec3; 16]>,
+    /// Their vertex ids, in the same order.
+    pub ring_ids: SmallVec<[u32; 16]>,
     /// The fan's radius: the farthest neighbour's distance from the merged vertex.
     pub radius: f32,
     /// Curvature of the new patch at the merged vertex (no torsion: see `test.rs`).
@@ -158,6 +160,7 @@ pub fn propose(adj: &Adjacency, cost: &QemCost, a: u32, b: u32) -> Option<Propos
         quadric_error,
         fan,
         ring,
+        ring_ids,
         radius,
         curvature,
         sites,
