@@ -39,7 +39,7 @@ use std::collections::BTreeMap;
 
 use glam::Vec3;
 
-use super::config::{DistanceConfig, ViewingConfig};
+use super::config::{DistanceConfig, SampleCount, ViewingConfig};
 use super::tables::{DistanceBound, DistanceRow, round7};
 use crate::error::Result;
 use crate::image::LinearImage;
@@ -119,6 +119,96 @@ pub struct DistanceJob<'a> {
     pub switch_m: Option<f64>,
 }
 
+/// Renders the original and the LOD as the display's viewer sees them at a given on-screen size
+/// and scores the pair, worst over the job's views.
+struct Prober<'a> {
+    job: &'a DistanceJob<'a>,
+    display: Screen,
+    vdp: Vdp,
+    flip: Flip,
+    sphere: crate::mesh::Sphere,
+    settings: RenderSettings,
+    side: u32,
+}
+
+impl<'a> Prober<'a> {
+    fn new(
+        job: &'a DistanceJob<'a>,
+        viewing: &ViewingConfig,
+        settings: &RenderSettings,
+        side: u32,
+    ) -> Prober<'a> {
+        let view = viewing.viewing();
+        Prober {
+            job,
+            display: Screen::new(viewing),
+            vdp: Vdp::new(&view, viewing.display()),
+            flip: Flip::new(view.ppd() as f32),
+            sphere: job.original.mesh().bounding_sphere(),
+            settings: *settings,
+            side,
+        }
+    }
+
+    /// The worst view's scores with the bounding sphere `diameter` display pixels across.
+    fn at(&self, diameter: f64) -> Result<Probe> {
+        let (display, sphere) = (&self.display, self.sphere);
+        let r_units = sphere.radius as f64;
+        let d_units = display.distance_for(r_units, diameter);
+        let size = (diameter * 1.1).ceil() as u32 + 8;
+        let mut s = self.settings;
+        s.width = size;
+        s.height = size;
+        s.samples = SamplePattern::Rotated(self.side);
+        // Vertical field of view of `size` display pixels.
+        let fov = 2.0 * ((size as f64 / 2.0) / display.k).atan();
+        let mut worst = Probe {
+            vdp: 0.0,
+            vdp_jnd: 0.0,
+            flip: 0.0,
+        };
+        for &dir in &self.job.directions {
+            let mut cam = Camera::frame_sphere(sphere, dir, 30.0, 1.0, 0.0);
+            let dir = cam.to_eye();
+            cam.eye = sphere.center + dir * d_units as f32;
+            cam.projection = Projection::Perspective {
+                fov_y_deg: fov.to_degrees() as f32,
+            };
+            cam.near = ((d_units - r_units * 1.01) as f32).max(d_units as f32 * 1e-4);
+            cam.far = (d_units + r_units * 1.01) as f32;
+            let a = LinearImage::from(&raster::render(self.job.original, &cam, &s)?);
+            let b = LinearImage::from(&raster::render(self.job.lod, &cam, &s)?);
+            let v = self.vdp.compare(&a, &b)?;
+            let f = self.flip.compare(&a, &b)?.mean;
+            worst.vdp = worst.vdp.max(v.probability);
+            worst.vdp_jnd = worst.vdp_jnd.max(v.jnd);
+            worst.flip = worst.flip.max(f);
+        }
+        Ok(worst)
+    }
+}
+
+/// How visible `job`'s LOD is at `distance_m` metres (viewer to the bounding sphere's centre):
+/// the worst of its views' VDP detection probability, VDP JND and FLIP mean, rendered as
+/// [`search`] renders its probes (`samples` per pixel, at most [`crate::limits::IMAGE_SIDE`]
+/// pixels across).
+pub fn visibility_at(
+    job: &DistanceJob,
+    viewing: &ViewingConfig,
+    settings: &RenderSettings,
+    samples: SampleCount,
+    distance_m: f64,
+) -> Result<(f64, f64, f64)> {
+    let prober = Prober::new(job, viewing, settings, samples.side());
+    let r_m = prober.sphere.radius as f64 * job.meters_per_unit;
+    let diameter = prober
+        .display
+        .diameter_px(r_m, distance_m.max(r_m * 1.0001))
+        .min(crate::limits::IMAGE_SIDE.max as f64 / 1.1 - 16.0);
+    let p = prober.at(diameter)?;
+    Ok((p.vdp, p.vdp_jnd, p.flip))
+}
+
 /// "Visible at this probe?"
 type Criterion = Box<dyn Fn(&Probe) -> bool>;
 
@@ -138,47 +228,14 @@ pub fn search(
     settings: &RenderSettings,
 ) -> Result<Vec<DistanceRow>> {
     let display = Screen::new(viewing);
-    let view = viewing.viewing();
-    let vdp = Vdp::new(&view, viewing.display());
-    let flip = Flip::new(view.ppd() as f32);
-    let sphere = job.original.mesh().bounding_sphere();
-    let r_units = sphere.radius as f64;
-    let n = config.samples.side();
+    let prober = Prober::new(job, viewing, settings, config.samples.side());
+    let r_units = prober.sphere.radius as f64;
     let mut probes: BTreeMap<u32, Probe> = BTreeMap::new();
     let mut probe = |diameter: u32| -> Result<Probe> {
         if let Some(p) = probes.get(&diameter) {
             return Ok(*p);
         }
-        let d_units = display.distance_for(r_units, diameter as f64);
-        let size = (diameter as f64 * 1.1).ceil() as u32 + 8;
-        let mut s = *settings;
-        s.width = size;
-        s.height = size;
-        s.samples = SamplePattern::Rotated(n);
-        // Vertical field of view of `size` display pixels.
-        let fov = 2.0 * ((size as f64 / 2.0) / display.k).atan();
-        let mut worst = Probe {
-            vdp: 0.0,
-            vdp_jnd: 0.0,
-            flip: 0.0,
-        };
-        for &dir in &job.directions {
-            let mut cam = Camera::frame_sphere(sphere, dir, 30.0, 1.0, 0.0);
-            let dir = cam.to_eye();
-            cam.eye = sphere.center + dir * d_units as f32;
-            cam.projection = Projection::Perspective {
-                fov_y_deg: fov.to_degrees() as f32,
-            };
-            cam.near = ((d_units - r_units * 1.01) as f32).max(d_units as f32 * 1e-4);
-            cam.far = (d_units + r_units * 1.01) as f32;
-            let a = LinearImage::from(&raster::render(job.original, &cam, &s)?);
-            let b = LinearImage::from(&raster::render(job.lod, &cam, &s)?);
-            let v = vdp.compare(&a, &b)?;
-            let f = flip.compare(&a, &b)?.mean;
-            worst.vdp = worst.vdp.max(v.probability);
-            worst.vdp_jnd = worst.vdp_jnd.max(v.jnd);
-            worst.flip = worst.flip.max(f);
-        }
+        let worst = prober.at(diameter as f64)?;
         probes.insert(diameter, worst);
         Ok(worst)
     };

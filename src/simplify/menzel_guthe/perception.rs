@@ -45,6 +45,8 @@ pub struct Perception {
     response: Response,
     sensitivity: [Sensitivity; 2],
     masking: Masking,
+    /// The threshold in JND: differences are compared with `jnd`·t_d (1 is the paper's).
+    jnd: f32,
     spectra: Cache<Spectrum>,
     /// Per harmonic: degree l and wave numbers (|m|, √(l(l+1) − m²)).
     harmonics: Vec<(usize, (f32, f32))>,
@@ -73,6 +75,7 @@ impl Perception {
                 Sensitivity::new(Channel::Chromatic),
             ],
             masking,
+            jnd: 1.0,
             spectra: Cache::new(CACHED_SPECTRA),
             harmonics: harmonics()
                 .map(|h| {
@@ -83,7 +86,14 @@ impl Perception {
         }
     }
 
-    /// The response model (for the silhouette's full contrast).
+    /// The same test with the threshold at `jnd` JND instead of 1 (a LOD "at 2 JND" tolerates
+    /// differences twice the just-noticeable one; the paper's user study used ¼ to 4).
+    pub fn with_jnd(mut self, jnd: f32) -> Perception {
+        self.jnd = jnd;
+        self
+    }
+
+    /// The response model (global masking's renders go through it).
     pub fn response(&self) -> &Response {
         &self.response
     }
@@ -163,7 +173,8 @@ impl Perception {
                             continue;
                         }
                         let phi = rotation::phase(alpha, l, w).min(std::f32::consts::PI);
-                        let factor = 2.0 * (0.5 * phi).sin();
+                        // (Divided by the threshold's multiple of a JND.)
+                        let factor = 2.0 * (0.5 * phi).sin() / self.jnd;
                         if factor <= 0.0 {
                             continue;
                         }
@@ -233,7 +244,8 @@ impl Perception {
                                 0.0
                             };
                             let delta =
-                                rotation::delta_max(a1, a2, rotation::phase(alpha, l, w) + phi_s);
+                                rotation::delta_max(a1, a2, rotation::phase(alpha, l, w) + phi_s)
+                                    / self.jnd;
                             if delta < visible {
                                 continue;
                             }

@@ -184,6 +184,8 @@ pub struct Original {
     welded: Vec<[u32; 3]>,
     closest: ClosestPoint,
     curvature: Vec<Curvature>,
+    /// A triangle at each welded vertex: where closest-point searches near it start.
+    at_vertex: Vec<u32>,
 }
 
 impl Original {
@@ -209,14 +211,21 @@ impl Original {
             })
             .collect();
         let weld = mesh.weld();
-        let welded = mesh
+        let welded: Vec<[u32; 3]> = mesh
             .triangles()
             .iter()
             .map(|t| t.map(|v| weld[v as usize]))
             .collect();
+        let mut at_vertex = vec![0u32; adj.positions.len()];
+        for (t, w) in welded.iter().enumerate().rev() {
+            for &v in w {
+                at_vertex[v as usize] = t as u32;
+            }
+        }
         Original {
             patches,
             welded,
+            at_vertex,
             closest: ClosestPoint::new(mesh),
             curvature: vertex_curvatures(adj),
         }
@@ -230,9 +239,33 @@ impl Original {
         Some((t, b, d))
     }
 
+    /// [`Original::closest`] for a point near the original's welded vertex `v` (the search
+    /// starts at one of its triangles; of equally near triangles, either may be returned).
+    pub fn closest_near(&self, q: Vec3, v: u32) -> Option<(u32, Vec3, f32)> {
+        let (t, d) = self.closest.closest_from(q, self.at_vertex(v))?;
+        let b = nearest_barycentric(q, self.closest.triangle(t));
+        Some((t, b, d))
+    }
+
     /// The distance from `q` to the original surface.
     pub fn distance(&self, q: Vec3) -> f32 {
         self.closest.distance(q)
+    }
+
+    /// The nearest triangle to `q` and the distance to it, the search starting from triangle
+    /// `hint` (the answer for a nearby point is a good start).
+    pub fn nearest_from(&self, q: Vec3, hint: u32) -> Option<(u32, f32)> {
+        self.closest.closest_from(q, hint)
+    }
+
+    /// A triangle of the original at its welded vertex `v`.
+    pub fn at_vertex(&self, v: u32) -> u32 {
+        self.at_vertex.get(v as usize).copied().unwrap_or(0)
+    }
+
+    /// The corners of the original's triangle `t`.
+    pub fn triangle(&self, t: u32) -> &[Vec3; 3] {
+        self.closest.triangle(t)
     }
 
     /// The point of triangle `t` at barycentric `b`, with the corners' curvatures interpolated
