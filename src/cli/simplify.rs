@@ -82,7 +82,8 @@ pub(crate) struct SimplifyArgs {
     /// Output .obj (with --chain: files STEM-rXX.obj beside it).
     #[arg(short, long, required_unless_present = "experiment")]
     pub(crate) out: Option<PathBuf>,
-    /// Run Williams et al. 2003's evaluation from a config (configs/papers/williams2003.toml).
+    /// Run a paper's evaluation from its config: configs/papers/williams2003.toml (Williams et al.
+    /// 2003) or configs/papers/menzel-guthe2010.toml (Menzel & Guthe 2010).
     #[arg(long, conflicts_with_all = ["mesh", "out"])]
     pub(crate) experiment: Option<PathBuf>,
     /// qem (our edge collapse, Garland–Heckbert quadrics), cluster (Rossignac–Borrel), meshopt,
@@ -144,6 +145,19 @@ pub(crate) struct SimplifyArgs {
 /// Run `simplify`.
 pub(crate) fn run(a: SimplifyArgs, quiet: bool) -> Result<(), Error> {
     if let Some(config) = &a.experiment {
+        if lodeval::experiments::paper_of(config)? == "menzel-guthe2010" {
+            let report = lodeval::experiments::menzel_guthe2010::run(config, &mut |line| {
+                if !quiet {
+                    note!("{line}")
+                }
+            })?;
+            return emit(&format!(
+                "{} Table 2 rows, {} Figure 1 materials, {} study LODs written\n",
+                report.table2.len(),
+                report.figure1.len(),
+                report.study.len()
+            ));
+        }
         let rows = lodeval::experiments::williams2003::run(config, &mut |line| note!("{line}"))?;
         note!("{} curve points written", rows.len());
         return Ok(());
