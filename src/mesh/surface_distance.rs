@@ -18,6 +18,7 @@
 use glam::Vec3;
 use obvhs::bvh2::Bvh2;
 use rayon::prelude::*;
+use smallvec::SmallVec;
 
 use super::Mesh;
 
@@ -117,7 +118,9 @@ impl ClosestPoint {
         if nodes.is_empty() {
             return None;
         }
-        let mut stack: Vec<u32> = Vec::with_capacity(64);
+        // A BVH of 2^32 triangles is at most a few hundred levels deep in practice; the small
+        // vector spills to the heap only beyond 64 pending nodes.
+        let mut stack: SmallVec<[u32; 64]> = SmallVec::new();
         stack.push(0);
         while let Some(n) = stack.pop() {
             let node = &nodes[n as usize];
