@@ -301,12 +301,13 @@ struct Candidate {
 }
 
 #[cfg(test)]
-mod tests {
+pub(super) mod tests {
     use super::*;
     use crate::simplify::menzel_guthe::curvature::Curvature;
     use crate::simplify::menzel_guthe::rotation::Frame;
 
-    fn perception() -> Perception {
+    /// The paper's grid, the default lighting and display, Daly's masking.
+    pub(in crate::simplify::menzel_guthe) fn perception() -> Perception {
         Perception::new(
             Grid::PAPER,
             Lighting::default(),

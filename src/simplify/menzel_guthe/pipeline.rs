@@ -552,18 +552,7 @@ pub(crate) fn measure_collapse(
 mod tests {
     use super::*;
     use crate::mesh::{LoadOptions, Material, shapes};
-    use crate::metric::vdp::Display;
-    use crate::simplify::menzel_guthe::field::{Grid, Lighting};
-    use crate::simplify::menzel_guthe::masking::Masking;
-
-    fn perception() -> Perception {
-        Perception::new(
-            Grid::PAPER,
-            Lighting::default(),
-            &Display::DEFAULT,
-            Masking::daly(),
-        )
-    }
+    use crate::simplify::menzel_guthe::perception::tests::perception;
 
     /// `mesh` with every triangle given `material`.
     fn with_material(mesh: &Mesh, material: Material) -> Mesh {
