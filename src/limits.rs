@@ -193,6 +193,41 @@ pub const RUNS: Bound<u64> = Bound {
     why: "the median of 1 000 runs is as good as it gets",
 };
 
+/// Vertices of a remesh (`remesh --vertices`): each is a Lloyd site and a triangulation vertex,
+/// and there can be no more than the UV layout's texels anyway.
+pub const REMESH_VERTICES: Bound<u64> = Bound {
+    min: 4,
+    max: 10_000_000,
+    unit: "vertices",
+    why: "a remesh needs a triangle's worth, and ten million take gigabytes of maps to place",
+};
+
+/// Texels per side of a remesh's maps (`remesh --map-size`): about a dozen maps of that size are
+/// held at once, 4–12 bytes per texel each.
+pub const REMESH_MAP: Bound<u64> = Bound {
+    min: 16,
+    max: 8192,
+    unit: "texels per side",
+    why: "an 8192² layout's maps take several GiB",
+};
+
+/// Lloyd iterations of a remesh (`remesh --lloyd-iterations`): only time grows with it.
+pub const LLOYD_ITERATIONS: Bound<u64> = Bound {
+    min: 0,
+    max: 1000,
+    unit: "iterations",
+    why: "Lloyd's relaxation settles in tens of iterations",
+};
+
+/// The gammas of a remesh's density (`--curvature-gamma`, `--perceptual-gamma`): the density
+/// goes with a map raised to it, so large values only reach the range of single precision.
+pub const REMESH_GAMMA: Bound<f64> = Bound {
+    min: 0.0,
+    max: 10.0,
+    unit: "",
+    why: "a map raised beyond the 10th power leaves single precision's range",
+};
+
 /// A mesh's size: its bounding-box diagonal in model units. Squared triangle areas (fourth
 /// powers of lengths) are formed in single precision, whose range is about 1e±38.
 pub const MESH_EXTENT: Bound<f64> = Bound {

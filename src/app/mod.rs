@@ -8,11 +8,13 @@ pub mod bench;
 pub mod calibrate;
 pub mod diff;
 pub mod optimize;
+pub mod remesh;
 pub mod render;
 pub mod simplify;
 
 pub use calibrate::*;
 pub use diff::*;
 pub use optimize::*;
+pub use remesh::*;
 pub use render::*;
 pub use simplify::*;

@@ -24,6 +24,7 @@ mod merge;
 mod optimize;
 mod print;
 mod progress;
+mod remesh;
 mod render;
 mod simplify;
 
@@ -67,6 +68,9 @@ enum Command {
     /// Image-driven optimization of a simplified mesh (Lindstrom & Turk): same vertex count,
     /// renderings closer to the original's.
     Optimize(optimize::OptimizeArgs),
+    /// Remesh a textured mesh with vertices placed by curvature and the visual masking of its
+    /// surface signal (Qu & Meyer), or by curvature or uniformly.
+    Remesh(remesh::RemeshArgs),
     /// Geometric error between two meshes: Hausdorff, mean and RMS surface distance (Metro-style).
     Geometry(geometry::GeometryArgs),
     /// Run a benchmark and print its table.
@@ -94,6 +98,7 @@ pub(crate) fn run(cli: Cli) -> Result<(), Error> {
         Command::Golden(a) => golden::run(a),
         Command::Simplify(a) => simplify::run(a, quiet),
         Command::Optimize(a) => optimize::run(a, quiet),
+        Command::Remesh(a) => remesh::run(a, quiet),
         Command::Geometry(a) => geometry::run(a),
         Command::Bench(a) => bench::run(a),
         Command::Merge(a) => merge::run(a),

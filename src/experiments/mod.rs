@@ -8,9 +8,12 @@
 //!   inputs, each optimized, energies on held-out views.
 //! - `menzel_guthe2010.rs` — Menzel & Guthe §6: Table 2 (triangles at 0.1 % and 1 % against our
 //!   QEM), Figure 1 (four materials), the user study's analogue (¼ to 4 JND against the VDP).
+//! - `qu_meyer.rs` — Qu & Meyer §5.3, Figure 7: uniform, curvature and perceptual remeshes at
+//!   equal vertex budgets, scored with FLIP and the VDP and by where their vertices went.
 
 pub mod lindstrom_turk;
 pub mod menzel_guthe2010;
+pub mod qu_meyer;
 pub mod williams2003;
 
 /// The paper a `simplify --experiment` config is for: its top-level `paper` key

@@ -2,7 +2,8 @@
 //! ([`LinearImage`]), is prepared once per reference where it has per-image work, and returns
 //! named results with units. One metric per file, in the order of the maths:
 //! `mse.rs` (MSE, PSNR, d_MS), `ssim.rs` (SSIM, MS-SSIM), `flip.rs` (ꟻLIP),
-//! `pool.rs` (pooling).
+//! `pool.rs` (pooling), `csf.rs` (contrast sensitivity), `tvi.rs` (threshold versus intensity),
+//! `vdp/` (the visible-difference predictor, one stage per file).
 
 pub mod colormap;
 pub mod csf;
@@ -10,6 +11,7 @@ pub mod flip;
 pub mod mse;
 pub mod pool;
 pub mod ssim;
+pub mod tvi;
 pub mod vdp;
 
 // The metrics' input and output types live below the metric layer (`crate::image`); re-exported

@@ -35,6 +35,7 @@ mod setup;
 pub(crate) mod shade;
 mod tangents;
 mod texture;
+pub mod texture_space;
 
 use rayon::prelude::*;
 
@@ -47,6 +48,7 @@ pub use scene::RenderScene;
 #[cfg(feature = "gpu")]
 pub(crate) use shade::ResolvedLight;
 pub use texture::MipTexture;
+pub use texture_space::{TextureSpace, texture_space};
 
 /// Shading models, by the names a config or the CLI uses.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]

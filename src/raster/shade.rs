@@ -146,9 +146,6 @@ impl ShadeContext<'_> {
         let tri = self.mesh.triangles()[st.tri as usize].map(|i| i as usize);
         let b = source_barycentrics(st, &corners, x, y);
         let lerp3 = |a: &[Vec3]| a[tri[0]] * b.x + a[tri[1]] * b.y + a[tri[2]] * b.z;
-        let material_id = self.mesh.material_ids()[st.tri as usize] as usize;
-        let material = &self.mesh.materials()[material_id];
-        let textures = &self.prepared.materials[material_id];
 
         match self.shading {
             Shading::Normals => return lerp3(self.mesh.normals()).normalize_or_zero() * 0.5 + 0.5,
@@ -166,15 +163,49 @@ impl ShadeContext<'_> {
             _ => {}
         }
 
-        // Surface colour: base colour × vertex colour × texture.
-        let uv_at =
-            |bb: Vec3, uvs: &[Vec2]| uvs[tri[0]] * bb.x + uvs[tri[1]] * bb.y + uvs[tri[2]] * bb.z;
         let uv_frame = self.mesh.uvs().map(|uvs| {
-            let uv = uv_at(b, uvs);
-            let dx = uv_at(source_barycentrics(st, &corners, x + 1.0, y), uvs) - uv;
-            let dy = uv_at(source_barycentrics(st, &corners, x, y + 1.0), uvs) - uv;
+            let uv_at = |bb: Vec3| uvs[tri[0]] * bb.x + uvs[tri[1]] * bb.y + uvs[tri[2]] * bb.z;
+            let uv = uv_at(b);
+            let dx = uv_at(source_barycentrics(st, &corners, x + 1.0, y)) - uv;
+            let dy = uv_at(source_barycentrics(st, &corners, x, y + 1.0)) - uv;
             (uv, dx, dy)
         });
+        Surface {
+            mesh: self.mesh,
+            prepared: self.prepared,
+            shading: self.shading,
+            lights: &self.lights,
+            ambient: self.ambient,
+            vertex_light: &self.vertex_light,
+        }
+        .color(st.tri as usize, b, uv_frame)
+    }
+}
+
+/// The one shading equation (the module comment's), for any pass that knows which source
+/// triangle it sees and where: the screen pass above, and the texture-space pass.
+pub(crate) struct Surface<'a> {
+    pub mesh: &'a Mesh,
+    pub prepared: &'a PreparedMesh,
+    /// `Unlit`, `Gouraud`, `Phong` or `NormalMapped` (the debug views are the screen pass's).
+    pub shading: Shading,
+    /// Lights, world space, resolved for the viewer of this sample.
+    pub lights: &'a [ResolvedLight],
+    pub ambient: f32,
+    /// Per-vertex (diffuse, specular) terms, for `Gouraud` only.
+    pub vertex_light: &'a [(Vec3, Vec3)],
+}
+
+impl Surface<'_> {
+    /// The colour of source triangle `t` at barycentrics `b`, with the texture coordinate and its
+    /// steps one pixel right and one down (`uv_frame`, for mip selection) where the mesh has UVs.
+    pub fn color(&self, t: usize, b: Vec3, uv_frame: Option<(Vec2, Vec2, Vec2)>) -> Vec3 {
+        let tri = self.mesh.triangles()[t].map(|i| i as usize);
+        let lerp3 = |a: &[Vec3]| a[tri[0]] * b.x + a[tri[1]] * b.y + a[tri[2]] * b.z;
+        let material_id = self.mesh.material_ids()[t] as usize;
+        let material = &self.mesh.materials()[material_id];
+        let textures = &self.prepared.materials[material_id];
+        // Surface colour: base colour × vertex colour × texture.
         let mut albedo = material.base_color;
         if let Some(colors) = self.mesh.colors() {
             albedo *= lerp3(colors);
@@ -208,7 +239,7 @@ impl ShadeContext<'_> {
                 }
                 light_terms(
                     n,
-                    &self.lights,
+                    self.lights,
                     self.ambient,
                     material.specular,
                     material.shininess,

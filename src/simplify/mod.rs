@@ -10,6 +10,7 @@ pub mod lindstrom_turk;
 pub mod menzel_guthe;
 pub mod meshopt;
 pub mod qem;
+pub mod qu_meyer;
 mod queue;
 pub mod williams;
 

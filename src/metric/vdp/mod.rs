@@ -335,26 +335,59 @@ impl Vdp {
         self.compare_prepared(&self.prepare(reference), &self.prepare(test))
     }
 
-    /// How strongly an image's own content masks errors (Qu & Meyer §4.2): per pixel the largest
-    /// threshold elevation (≥ 1) over bands, 1 meaning no masking.
+    /// How strongly an image's own content masks errors: per pixel the largest threshold
+    /// elevation (≥ 1) over bands, 1 meaning no masking.
     pub fn masking_map(&self, image: &LinearImage) -> ErrorMap {
         let p = self.prepare(image);
-        let (w, h) = (p.width, p.height);
-        let mut out = vec![1.0f32; w * h];
-        for (k, (band, m)) in p.bands.iter().zip(&p.maskers).enumerate() {
-            let (bw, bh) = (band.w, band.h);
-            out.par_chunks_mut(w).enumerate().for_each(|(y, row)| {
-                let by = (y >> k).min(bh - 1);
-                for (x, o) in row.iter_mut().enumerate() {
-                    *o = o.max(threshold_elevation(m[by * bw + (x >> k).min(bw - 1)]));
-                }
-            });
-        }
-        ErrorMap {
-            width: w,
-            height: h,
-            values: out,
-        }
+        let maskers: Vec<(usize, usize, &[f32])> = p
+            .bands
+            .iter()
+            .zip(&p.maskers)
+            .map(|(b, m)| (b.w, b.h, m.as_slice()))
+            .collect();
+        elevation_map(p.width, p.height, &maskers)
+    }
+
+    /// Qu & Meyer §4.2's visual masking map: `image` compared with `smooth`, its low-passed
+    /// copy, through stages 1–5, so that only the detail the low pass removed counts (a slow
+    /// gradient or a step between flat regions masks little), and per pixel the largest
+    /// threshold elevation (≥ 1) that the difference's local band magnitude gives.
+    pub fn masking_against(&self, image: &LinearImage, smooth: &LinearImage) -> Result<ErrorMap> {
+        same_size(image, smooth)?;
+        let (a, b) = (self.prepare(image), self.prepare(smooth));
+        let detail: Vec<(usize, usize, Vec<f32>)> = a
+            .bands
+            .iter()
+            .zip(&b.bands)
+            .map(|(x, y)| {
+                let d: Vec<f32> = x.v.iter().zip(&y.v).map(|(p, q)| p - q).collect();
+                (x.w, x.h, masking::local_magnitude(&d, x.w, x.h))
+            })
+            .collect();
+        let maskers: Vec<(usize, usize, &[f32])> = detail
+            .iter()
+            .map(|(w, h, m)| (*w, *h, m.as_slice()))
+            .collect();
+        Ok(elevation_map(a.width, a.height, &maskers))
+    }
+}
+
+/// Per pixel of a `w × h` image, the largest [`threshold_elevation`] over bands of masker
+/// magnitudes `(band width, band height, values)`, band k at 1/2^k resolution.
+fn elevation_map(w: usize, h: usize, maskers: &[(usize, usize, &[f32])]) -> ErrorMap {
+    let mut out = vec![1.0f32; w * h];
+    for (k, &(bw, bh, m)) in maskers.iter().enumerate() {
+        out.par_chunks_mut(w).enumerate().for_each(|(y, row)| {
+            let by = (y >> k).min(bh - 1);
+            for (x, o) in row.iter_mut().enumerate() {
+                *o = o.max(threshold_elevation(m[by * bw + (x >> k).min(bw - 1)]));
+            }
+        });
+    }
+    ErrorMap {
+        width: w,
+        height: h,
+        values: out,
     }
 }
 

@@ -1,0 +1,551 @@
+//! Qu & Meyer: perceptually driven remeshing — where the surface signal (texture, normal-map
+//! relief, lighting) masks geometric detail, fewer vertices are needed, so the vertices of a new
+//! mesh are placed by a density that follows the surface's curvature and falls where the
+//! signal's visual masking map is strong.
+//!
+//! Based on: Lijun Qu, Gary Meyer. Perceptually Driven Interactive Geometry Remeshing. I3D 2006;
+//! Pierre Alliez, Mark Meyer, Mathieu Desbrun. Interactive Geometry Remeshing. SIGGRAPH 2002 (the
+//! map-based framework it builds on).
+//!
+//! One stage per file, in the order they run:
+//! - `raster::texture_space` — §4.3: the mesh rendered into its UV domain (the surface signal and
+//!   the 3D point of every texel);
+//! - `charts.rs` — the UV charts, their boundaries and the seams between them;
+//! - `maps.rs` — §5.1: area distortion and curvature per texel;
+//! - `masking.rs` — §4.2: the visual masking map (the calibrated VDP's masking stage and the TVI);
+//! - `density.rs` — §5.2: the density with its two gammas, each chart's share;
+//! - `sampling.rs` — §5.2: the first samples, by error diffusion;
+//! - `lloyd.rs` — §5.2: Lloyd relaxation of the density-weighted CVT;
+//! - `triangulate.rs` — §3, §5.3: constrained Delaunay in UV, projected back to 3D.
+//!
+//! The vertex budget counts 3D points: a seam vertex is one vertex however many charts share it
+//! (the output, like the input, stores one copy per chart for their different UVs).
+//!
+//! Decision where the paper and the issue meet: a CVT's samples follow its weight w as
+//! w^(d/(d+2)) (Gersho 1979), w^½ on a surface, so Lloyd's centroids (Equation 1) are weighted
+//! with ρ² to keep the vertex counts following the density's integral, as error diffusion gives
+//! them; with ρ itself (the paper's literal Equation 1) a region twice as dense would get only
+//! √2 times the vertices.
+
+pub mod charts;
+pub mod density;
+pub mod lloyd;
+pub mod maps;
+pub mod masking;
+pub mod sampling;
+pub mod triangulate;
+
+use std::sync::Arc;
+use std::time::Instant;
+
+use glam::{Vec2, Vec3};
+
+use crate::error::{Error, Result};
+use crate::mesh::Mesh;
+use crate::metric::vdp::Display;
+use crate::raster::{RenderScene, TextureSpace, texture_space};
+use crate::scene::Viewing;
+
+use self::charts::Charts;
+use self::density::{Density, apportion};
+use self::maps::Maps;
+
+/// Which density drives the samples.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Method {
+    /// Curvature and the masking map (the paper's method).
+    QuMeyer,
+    /// Curvature only (the perceptual gamma 0).
+    Curvature,
+    /// Neither: uniform on the surface (both gammas 0; the paper's baseline).
+    Uniform,
+}
+
+impl Method {
+    /// All methods, in the order the CLI lists them.
+    pub const ALL: [Method; 3] = [Method::QuMeyer, Method::Curvature, Method::Uniform];
+
+    /// The CLI and config name.
+    pub fn name(self) -> &'static str {
+        match self {
+            Method::QuMeyer => "qu-meyer",
+            Method::Curvature => "curvature",
+            Method::Uniform => "uniform",
+        }
+    }
+}
+
+/// Settings of a remesh.
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[non_exhaustive]
+pub struct Options {
+    /// Vertices of the result (3D points). Required.
+    pub vertices: usize,
+    /// Which density. Default value: `QuMeyer`.
+    pub method: Method,
+    /// γ_c, the curvature map's weight. Default value: 1.2 (the paper's Figure 7c, d).
+    pub curvature_gamma: f64,
+    /// γ_p, the masking map's weight. Default value: 1.0 (the paper's Figure 7b).
+    pub perceptual_gamma: f64,
+    /// Lloyd iterations. Default value: 20 (the paper: 10–20).
+    pub lloyd_iterations: usize,
+    /// Texels per side of the maps. Default value: 512 (the paper's Figure 5).
+    pub map_size: usize,
+    /// Pixels per degree the map is seen at (one texel per pixel). Default value: the default
+    /// display's (0.7 m wide, 3840 px, seen from 0.7 m: about 67).
+    pub ppd: f64,
+    /// The display. Default value: [`Display::DEFAULT`].
+    pub display: Display,
+    /// Keep the maps as pictures. Default value: false.
+    pub keep_maps: bool,
+}
+
+impl Options {
+    /// The defaults, for `vertices` vertices.
+    pub fn new(vertices: usize) -> Options {
+        Options {
+            vertices,
+            method: Method::QuMeyer,
+            curvature_gamma: 1.2,
+            perceptual_gamma: 1.0,
+            lloyd_iterations: 20,
+            map_size: 512,
+            ppd: Viewing::DEFAULT.ppd(),
+            display: Display::DEFAULT,
+            keep_maps: false,
+        }
+    }
+
+    /// The gammas the method uses.
+    pub fn gammas(&self) -> (f64, f64) {
+        match self.method {
+            Method::QuMeyer => (self.curvature_gamma, self.perceptual_gamma),
+            Method::Curvature => (self.curvature_gamma, 0.0),
+            Method::Uniform => (0.0, 0.0),
+        }
+    }
+
+    /// Check every value before any work.
+    pub fn check(&self) -> Result<()> {
+        use crate::limits::{LLOYD_ITERATIONS, PPD, REMESH_GAMMA, REMESH_MAP, REMESH_VERTICES};
+        for (name, g) in [
+            ("--curvature-gamma", self.curvature_gamma),
+            ("--perceptual-gamma", self.perceptual_gamma),
+        ] {
+            if !REMESH_GAMMA.contains(g) {
+                return Err(Error::Usage(format!(
+                    "{name} {g}: a gamma is a number from 0 to {} (0 turns its map off)",
+                    REMESH_GAMMA.max
+                )));
+            }
+        }
+        REMESH_VERTICES
+            .check("--vertices", self.vertices as u64)
+            .and(REMESH_MAP.check("--map-size", self.map_size as u64))
+            .and(LLOYD_ITERATIONS.check("--lloyd-iterations", self.lloyd_iterations as u64))
+            .and(PPD.check("--ppd", self.ppd))
+            .map_err(Error::Usage)?;
+        Ok(())
+    }
+}
+
+/// Seconds per stage (wall clock; reporting only).
+#[derive(Debug, Clone, Copy, Default, PartialEq, serde::Serialize)]
+pub struct Seconds {
+    /// The texture-space pass, charts, curvature and distortion maps.
+    pub maps: f64,
+    /// The masking map.
+    pub masking: f64,
+    /// Density, boundary sampling and error diffusion.
+    pub sampling: f64,
+    /// Lloyd relaxation.
+    pub lloyd: f64,
+    /// Triangulation and projection to 3D.
+    pub triangulation: f64,
+}
+
+/// The maps as pictures (8-bit sRGB, map size), for people to look at.
+#[derive(Debug, Clone)]
+pub struct MapImages {
+    /// The surface signal.
+    pub signal: image::RgbImage,
+    /// The masking map, brighter = stronger masking.
+    pub masking: image::RgbImage,
+    /// The curvature map.
+    pub curvature: image::RgbImage,
+    /// The density in the domain.
+    pub density: image::RgbImage,
+    /// The final samples over the density (boundary vertices in cyan, free ones in white).
+    pub samples: image::RgbImage,
+}
+
+/// A remesh and what it took.
+#[derive(Debug, Clone)]
+pub struct Remesh {
+    /// The new mesh.
+    pub mesh: Mesh,
+    /// 3D points (welded vertices) of the new mesh.
+    pub vertices: usize,
+    /// Boundary (seam) vertices among them.
+    pub boundary_vertices: usize,
+    /// UV charts.
+    pub charts: usize,
+    /// Lloyd iterations run.
+    pub iterations: usize,
+    /// Seconds per stage.
+    pub seconds: Seconds,
+    /// Share of the vertices in the most strongly masked quarter of the surface (by area).
+    pub masked_share: f64,
+    /// The maps as pictures, when asked for.
+    pub maps: Option<MapImages>,
+}
+
+/// Remesh `mesh` (which must have texture coordinates).
+pub fn remesh(mesh: &Arc<Mesh>, options: &Options) -> Result<Remesh> {
+    options.check()?;
+    if mesh.uvs().is_none() {
+        return Err(Error::input(
+            &mesh.source().path,
+            "the mesh has no texture coordinates; qu-meyer remeshes in the UV domain",
+            "give a mesh with texture coordinates (unwrap it in a modelling tool first)",
+        ));
+    }
+    let mut seconds = Seconds::default();
+    let t = Instant::now();
+    let ts = texture_space(&RenderScene::of(mesh.clone()), options.map_size)?;
+    if ts.overlapping * 200 > ts.covered {
+        return Err(Error::input(
+            &mesh.source().path,
+            format!(
+                "{:.1} % of the UV layout is covered by more than one triangle (overlapping or \
+                 mirrored charts), so texels do not map to one point of the surface",
+                100.0 * ts.overlapping as f64 / ts.covered.max(1) as f64
+            ),
+            "qu-meyer needs a one-to-one UV layout: unwrap the mesh without overlaps, or give \
+             mirrored parts their own space in the atlas",
+        ));
+    }
+    if options.vertices > ts.covered {
+        return Err(Error::Usage(format!(
+            "--vertices {}: more than the {} texels the UV layout covers at --map-size {}; ask \
+             for fewer vertices or a larger map",
+            options.vertices, ts.covered, options.map_size
+        )));
+    }
+    let charts = Charts::of(mesh);
+    let maps = Maps::new(mesh, &ts, &charts);
+    seconds.maps = t.elapsed().as_secs_f64();
+
+    let t = Instant::now();
+    let covered: Vec<bool> = maps.chart.iter().map(|&c| c != u32::MAX).collect();
+    let (gc, gp) = options.gammas();
+    let masking = if gp != 0.0 || options.keep_maps || options.method == Method::QuMeyer {
+        Some(masking::masking_map(
+            ts.size,
+            &ts.signal,
+            &covered,
+            options.ppd,
+            options.display,
+        )?)
+    } else {
+        None
+    };
+    seconds.masking = t.elapsed().as_secs_f64();
+
+    let t = Instant::now();
+    let ones = vec![1.0f32; ts.size * ts.size];
+    let m = masking.as_ref().map_or(&ones, |m| &m.masking);
+    let density = Density::new(&maps.curvature, m, &maps, charts.count, (gc, gp));
+    let welded = welded_positions(mesh);
+    let representative = representative_texels(mesh, &ts);
+    let mass = density.mass();
+    let base = ((2.0 / 3f64.sqrt()) * mass / options.vertices as f64).sqrt();
+    let mut refine = vec![false; welded.len()];
+    let mut scale = 1.0f64;
+    let mut keep = Vec::new();
+    let mut boundary = 0;
+    for _ in 0..40 {
+        let spacing = |w: u32| {
+            let r = representative[w as usize].map_or(0.0, |i| density.surface[i]);
+            let r = if r > 0.0 { r as f64 } else { 1.0 };
+            (scale * base / r.sqrt()) as f32
+        };
+        keep = charts.keep(&welded, &spacing, &refine);
+        boundary = keep.iter().filter(|&&k| k).count();
+        if boundary * 2 <= options.vertices {
+            break;
+        }
+        scale *= 1.25;
+    }
+    if boundary >= options.vertices {
+        return Err(Error::Usage(format!(
+            "--vertices {}: the UV layout's {} charts need {} vertices on their seams alone; ask \
+             for more vertices",
+            options.vertices, charts.count, boundary
+        )));
+    }
+    let targets = apportion(options.vertices - boundary, &density.chart_mass);
+    let mut free = sampling::error_diffusion(ts.size, &maps.chart, &density.domain, &targets);
+    seconds.sampling = t.elapsed().as_secs_f64();
+
+    let t = Instant::now();
+    let weights: Vec<f32> = density.domain.iter().map(|&d| d * d).collect();
+    let mut texels: Vec<Vec<u32>> = vec![Vec::new(); charts.count];
+    for (i, &c) in maps.chart.iter().enumerate() {
+        if c != u32::MAX {
+            texels[c as usize].push(i as u32);
+        }
+    }
+    for (c, samples) in free.iter_mut().enumerate() {
+        let fixed = fixed_sites(mesh, &ts, &charts, &keep, c);
+        let chart = &maps.chart;
+        let size = ts.size;
+        let in_chart = |p: Vec2| {
+            let (x, y) = (p.x.floor(), p.y.floor());
+            x >= 0.0
+                && y >= 0.0
+                && (x as usize) < size
+                && (y as usize) < size
+                && chart[y as usize * size + x as usize] == c as u32
+        };
+        lloyd::relax(
+            ts.size,
+            &texels[c],
+            &weights,
+            &in_chart,
+            &fixed,
+            samples,
+            options.lloyd_iterations,
+        );
+    }
+    seconds.lloyd = t.elapsed().as_secs_f64();
+
+    let t = Instant::now();
+    let built = loop {
+        match triangulate::triangulate(mesh, &ts, &charts, &keep, &free) {
+            Ok(b) => break b,
+            Err(Ok(more)) => {
+                for w in more {
+                    refine[w as usize] = true;
+                    keep[w as usize] = true;
+                }
+            }
+            Err(Err(e)) => return Err(e),
+        }
+    };
+    let out = built.into_mesh(mesh)?;
+    seconds.triangulation = t.elapsed().as_secs_f64();
+
+    let masked_share = masked_share(&out, &ts, &maps, m);
+    let images = options
+        .keep_maps
+        .then(|| map_images(&ts, &maps, masking.as_ref(), &density, &out));
+    Ok(Remesh {
+        vertices: out.welded_vertex_count(),
+        boundary_vertices: keep.iter().filter(|&&k| k).count(),
+        charts: charts.count,
+        iterations: options.lloyd_iterations,
+        seconds,
+        masked_share,
+        maps: images,
+        mesh: out,
+    })
+}
+
+/// Position per welded vertex.
+fn welded_positions(mesh: &Mesh) -> Vec<Vec3> {
+    let mut p = vec![Vec3::ZERO; mesh.welded_vertex_count()];
+    for (v, &w) in mesh.weld().iter().enumerate() {
+        p[w as usize] = mesh.positions()[v];
+    }
+    p
+}
+
+/// Per welded vertex, a covered texel at (or within two texels of) its lowest copy's UV.
+fn representative_texels(mesh: &Mesh, ts: &TextureSpace) -> Vec<Option<usize>> {
+    let uvs = mesh.uvs().unwrap_or_default();
+    let mut out = vec![None; mesh.welded_vertex_count()];
+    for (v, &w) in mesh.weld().iter().enumerate().rev() {
+        let p = ts.texel_of(uvs[v]);
+        let (x0, y0) = (p.x.floor() as isize, p.y.floor() as isize);
+        let s = ts.size as isize;
+        let mut found = None;
+        'search: for r in 0..=2isize {
+            for y in y0 - r..=y0 + r {
+                for x in x0 - r..=x0 + r {
+                    if (0..s).contains(&x) && (0..s).contains(&y) {
+                        let i = (y * s + x) as usize;
+                        if ts.triangle[i] != crate::raster::NO_TRIANGLE {
+                            found = Some(i);
+                            break 'search;
+                        }
+                    }
+                }
+            }
+        }
+        if found.is_some() {
+            out[w as usize] = found;
+        }
+    }
+    out
+}
+
+/// Chart `c`'s kept boundary vertices as texel coordinates.
+fn fixed_sites(
+    mesh: &Mesh,
+    ts: &TextureSpace,
+    charts: &Charts,
+    keep: &[bool],
+    c: usize,
+) -> Vec<Vec2> {
+    let uvs = mesh.uvs().unwrap_or_default();
+    let weld = mesh.weld();
+    charts.loops[c]
+        .iter()
+        .flatten()
+        .filter(|&&v| keep[weld[v as usize] as usize])
+        .map(|&v| ts.texel_of(uvs[v as usize]))
+        .collect()
+}
+
+/// Share of `out`'s vertices that lie where the masking map is in its strongest quarter of the
+/// covered surface (by 3D area).
+fn masked_share(out: &Mesh, ts: &TextureSpace, maps: &Maps, masking: &[f32]) -> f64 {
+    let mut by_mask: Vec<(f32, f32)> = masking
+        .iter()
+        .zip(&maps.area)
+        .filter(|(_, a)| **a > 0.0)
+        .map(|(&m, &a)| (m, a))
+        .collect();
+    by_mask.sort_by(|a, b| b.0.total_cmp(&a.0));
+    let total: f64 = by_mask.iter().map(|x| x.1 as f64).sum();
+    let mut acc = 0.0;
+    let mut threshold = f32::INFINITY;
+    for (m, a) in &by_mask {
+        acc += *a as f64;
+        threshold = *m;
+        if acc >= 0.25 * total {
+            break;
+        }
+    }
+    let uvs = out.uvs().unwrap_or_default();
+    let mut seen = vec![false; out.welded_vertex_count()];
+    let (mut inside, mut all) = (0usize, 0usize);
+    for (v, &w) in out.weld().iter().enumerate() {
+        if std::mem::replace(&mut seen[w as usize], true) {
+            continue;
+        }
+        all += 1;
+        let p = ts.texel_of(uvs[v]);
+        let (x, y) = (p.x.floor() as isize, p.y.floor() as isize);
+        let s = ts.size as isize;
+        if (0..s).contains(&x) && (0..s).contains(&y) {
+            let i = (y * s + x) as usize;
+            if maps.area[i] > 0.0 && masking[i] >= threshold {
+                inside += 1;
+            }
+        }
+    }
+    if all == 0 {
+        0.0
+    } else {
+        inside as f64 / all as f64
+    }
+}
+
+/// The maps as pictures.
+fn map_images(
+    ts: &TextureSpace,
+    maps: &Maps,
+    masking: Option<&masking::MaskingMap>,
+    density: &Density,
+    out: &Mesh,
+) -> MapImages {
+    let s = ts.size as u32;
+    let covered = |i: usize| maps.chart[i] != u32::MAX;
+    let grey = [40u8, 40, 40];
+    let to_rgb = |f: &dyn Fn(usize) -> [u8; 3]| {
+        image::RgbImage::from_fn(s, s, |x, y| {
+            let i = (y * s + x) as usize;
+            image::Rgb(if covered(i) { f(i) } else { grey })
+        })
+    };
+    // A map scaled to its 99th percentile over covered texels, through magma.
+    let scaled = |v: &[f32]| {
+        let mut c: Vec<f32> = (0..v.len()).filter(|&i| covered(i)).map(|i| v[i]).collect();
+        c.sort_by(f32::total_cmp);
+        let lo = c.first().copied().unwrap_or(0.0);
+        let hi = c
+            .get(c.len() * 99 / 100)
+            .copied()
+            .unwrap_or(1.0)
+            .max(lo + 1e-12);
+        to_rgb(&|i| crate::metric::colormap::magma(((v[i] - lo) / (hi - lo)).clamp(0.0, 1.0)))
+    };
+    let signal = to_rgb(&|i| {
+        let c = ts.signal[i];
+        [c.x, c.y, c.z]
+            .map(|v| (crate::color::linear_to_srgb(v.clamp(0.0, 1.0)) * 255.0).round() as u8)
+    });
+    let masking_img = match masking {
+        Some(m) => {
+            // log M: 1 (none) black, the strongest white.
+            let l: Vec<f32> = m.masking.iter().map(|v| v.max(1e-6).ln()).collect();
+            let hi = (0..l.len())
+                .filter(|&i| covered(i))
+                .map(|i| l[i])
+                .fold(1e-6f32, f32::max);
+            let lo = (0..l.len())
+                .filter(|&i| covered(i))
+                .map(|i| l[i])
+                .fold(0.0f32, f32::min);
+            to_rgb(&|i| [(((l[i] - lo) / (hi - lo)).clamp(0.0, 1.0) * 255.0) as u8; 3])
+        }
+        None => to_rgb(&|_| [0, 0, 0]),
+    };
+    let curvature = scaled(&maps.curvature);
+    let density_img = scaled(&density.domain);
+    let mut samples = density_img.clone();
+    let uvs = out.uvs().unwrap_or_default();
+    let mut boundary = vec![false; out.vertex_count()];
+    // Boundary vertices of the output: on an edge of one triangle.
+    let mut edges: Vec<(u32, u32)> = out
+        .triangles()
+        .iter()
+        .flat_map(|t| (0..3).map(move |k| (t[k].min(t[(k + 1) % 3]), t[k].max(t[(k + 1) % 3]))))
+        .collect();
+    edges.sort_unstable();
+    let mut i = 0;
+    while i < edges.len() {
+        let mut j = i + 1;
+        while j < edges.len() && edges[j] == edges[i] {
+            j += 1;
+        }
+        if j - i == 1 {
+            boundary[edges[i].0 as usize] = true;
+            boundary[edges[i].1 as usize] = true;
+        }
+        i = j;
+    }
+    for (v, uv) in uvs.iter().enumerate() {
+        let p = ts.texel_of(*uv);
+        let colour = if boundary[v] {
+            [0u8, 230, 230]
+        } else {
+            [255u8, 255, 255]
+        };
+        for (dx, dy) in [(0, 0), (1, 0), (0, 1), (1, 1)] {
+            let (x, y) = (p.x.floor() as i64 + dx - 1, p.y.floor() as i64 + dy - 1);
+            if (0..s as i64).contains(&x) && (0..s as i64).contains(&y) {
+                samples.put_pixel(x as u32, y as u32, image::Rgb(colour));
+            }
+        }
+    }
+    MapImages {
+        signal,
+        masking: masking_img,
+        curvature,
+        density: density_img,
+        samples,
+    }
+}
