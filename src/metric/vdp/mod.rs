@@ -373,14 +373,28 @@ impl Vdp {
 }
 
 /// Per pixel of a `w × h` image, the largest [`threshold_elevation`] over bands of masker
-/// magnitudes `(band width, band height, values)`, band k at 1/2^k resolution.
+/// magnitudes `(band width, band height, values)`, band k at 1/2^k resolution, each band's
+/// elevations interpolated bilinearly between its sample centres (so a coarse band does not
+/// print its sampling grid into the map).
 fn elevation_map(w: usize, h: usize, maskers: &[(usize, usize, &[f32])]) -> ErrorMap {
     let mut out = vec![1.0f32; w * h];
     for (k, &(bw, bh, m)) in maskers.iter().enumerate() {
+        let e: Vec<f32> = m.iter().map(|&v| threshold_elevation(v)).collect();
+        let scale = 1.0 / (1u64 << k) as f32;
+        // Band coordinate of pixel coordinate i: sample centres at (j + ½)·2^k − ½.
+        let at = |i: usize, n: usize| {
+            let u = ((i as f32 + 0.5) * scale - 0.5).clamp(0.0, (n - 1) as f32);
+            let j = (u.floor() as usize).min(n - 1);
+            (j, (j + 1).min(n - 1), u - j as f32)
+        };
+        let xs: Vec<(usize, usize, f32)> = (0..w).map(|x| at(x, bw)).collect();
         out.par_chunks_mut(w).enumerate().for_each(|(y, row)| {
-            let by = (y >> k).min(bh - 1);
-            for (x, o) in row.iter_mut().enumerate() {
-                *o = o.max(threshold_elevation(m[by * bw + (x >> k).min(bw - 1)]));
+            let (y0, y1, fy) = at(y, bh);
+            let (r0, r1) = (&e[y0 * bw..][..bw], &e[y1 * bw..][..bw]);
+            for (o, &(x0, x1, fx)) in row.iter_mut().zip(&xs) {
+                let top = r0[x0] + (r0[x1] - r0[x0]) * fx;
+                let bottom = r1[x0] + (r1[x1] - r1[x0]) * fx;
+                *o = o.max(top + (bottom - top) * fy);
             }
         });
     }

@@ -549,3 +549,254 @@ fn map_images(
         samples,
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mesh::{LoadOptions, shapes};
+
+    /// An n×n grid per face of the cube [−1, 1]³, each face its own UV island of a 3×2 atlas
+    /// (with gaps), so the cube is closed in 3D and cut into six charts in UV.
+    fn atlas_cube(n: u32) -> Mesh {
+        let mut data = shapes::grid_plane(1).to_data();
+        let (mut positions, mut uvs, mut triangles) = (Vec::new(), Vec::new(), Vec::new());
+        let axes = [
+            (Vec3::X, Vec3::Z, Vec3::Y),
+            (-Vec3::X, -Vec3::Z, Vec3::Y),
+            (Vec3::Y, Vec3::X, Vec3::Z),
+            (-Vec3::Y, Vec3::X, -Vec3::Z),
+            (Vec3::Z, -Vec3::X, Vec3::Y),
+            (-Vec3::Z, Vec3::X, Vec3::Y),
+        ];
+        for (f, (normal, u, v)) in axes.into_iter().enumerate() {
+            // u × v must point along the normal for counter-clockwise winding from outside.
+            let (u, v) = if u.cross(v).dot(normal) > 0.0 {
+                (u, v)
+            } else {
+                (v, u)
+            };
+            let base = positions.len() as u32;
+            let cell = Vec2::new((f % 3) as f32, (f / 3) as f32);
+            for j in 0..=n {
+                for i in 0..=n {
+                    let (s, t) = (i as f32 / n as f32, j as f32 / n as f32);
+                    // Integer coordinates first, so that shared edges weld exactly.
+                    let k = (
+                        n as f32,
+                        (2 * i) as f32 - n as f32,
+                        (2 * j) as f32 - n as f32,
+                    );
+                    positions.push((normal * k.0 + u * k.1 + v * k.2) / n as f32);
+                    uvs.push((cell + Vec2::new(0.05, 0.05) + Vec2::new(s, t) * 0.9) / 3.0);
+                }
+            }
+            let id = |i: u32, j: u32| base + j * (n + 1) + i;
+            for j in 0..n {
+                for i in 0..n {
+                    triangles.push([id(i, j), id(i + 1, j), id(i + 1, j + 1)]);
+                    triangles.push([id(i, j), id(i + 1, j + 1), id(i, j + 1)]);
+                }
+            }
+        }
+        data.positions = positions;
+        data.uvs = Some(uvs);
+        data.normals = None;
+        data.triangles = triangles;
+        data.material_ids = Vec::new();
+        Mesh::new(data, &LoadOptions::DEFAULT).unwrap()
+    }
+
+    /// Welded edges used by other than two triangles.
+    fn open_edges(mesh: &Mesh) -> usize {
+        let w = mesh.weld();
+        let mut edges: Vec<(u32, u32)> = mesh
+            .triangles()
+            .iter()
+            .flat_map(|t| {
+                (0..3).map(move |k| {
+                    let (a, b) = (w[t[k] as usize], w[t[(k + 1) % 3] as usize]);
+                    (a.min(b), a.max(b))
+                })
+            })
+            .collect();
+        edges.sort_unstable();
+        let mut bad = 0;
+        let mut i = 0;
+        while i < edges.len() {
+            let mut j = i + 1;
+            while j < edges.len() && edges[j] == edges[i] {
+                j += 1;
+            }
+            if j - i != 2 {
+                bad += 1;
+            }
+            i = j;
+        }
+        bad
+    }
+
+    fn small(vertices: usize) -> Options {
+        Options {
+            map_size: 256,
+            ..Options::new(vertices)
+        }
+    }
+
+    #[test]
+    fn the_remeshed_plane_is_the_plane() {
+        let mut data = shapes::grid_plane(8).to_data();
+        data.uvs = Some(
+            data.positions
+                .iter()
+                .map(|p| Vec2::new(p.x, p.y) / 8.0)
+                .collect(),
+        );
+        let plane = Arc::new(Mesh::new(data, &LoadOptions::DEFAULT).unwrap());
+        let r = remesh(&plane, &small(150)).unwrap();
+        let m = &r.mesh;
+        assert!(m.positions().iter().all(|p| p.z == 0.0));
+        // The same square: its corners kept, its area covered exactly once.
+        let area: f32 = m
+            .triangles()
+            .iter()
+            .map(|t| {
+                let [a, b, c] = t.map(|i| m.positions()[i as usize]);
+                (b - a).cross(c - a).z * 0.5
+            })
+            .sum();
+        assert!((area - 64.0).abs() < 1e-3, "{area}");
+        let bb = m.aabb();
+        assert_eq!((bb.min, bb.max), (Vec3::ZERO, Vec3::new(8.0, 8.0, 0.0)));
+        // UVs still map the plane linearly.
+        let uvs = m.uvs().unwrap();
+        for (p, uv) in m.positions().iter().zip(uvs) {
+            assert!((Vec2::new(p.x, p.y) / 8.0 - *uv).length() < 1e-4);
+        }
+        assert!((140..=150).contains(&r.vertices), "{}", r.vertices);
+    }
+
+    #[test]
+    fn a_closed_textured_mesh_stays_closed_and_its_seams_match() {
+        let cube = Arc::new(atlas_cube(6));
+        assert_eq!(open_edges(&cube), 0);
+        let r = remesh(&cube, &small(300)).unwrap();
+        assert_eq!(r.charts, 6);
+        assert_eq!(open_edges(&r.mesh), 0, "the remeshed cube has holes");
+        // Every vertex lies on the cube's surface.
+        for p in r.mesh.positions() {
+            assert!((p.abs().max_element() - 1.0).abs() < 1e-5, "{p}");
+        }
+        // Spot: 13 charts, closed, the same check.
+        let spot = Arc::new(
+            crate::mesh::load(
+                std::path::Path::new(concat!(
+                    env!("CARGO_MANIFEST_DIR"),
+                    "/reference/models/spot/spot_mtl.obj"
+                )),
+                &LoadOptions::DEFAULT,
+            )
+            .unwrap(),
+        );
+        assert_eq!(open_edges(&spot), 0);
+        let r = remesh(&spot, &small(800)).unwrap();
+        assert_eq!(open_edges(&r.mesh), 0, "the remeshed Spot has holes");
+        assert!((770..=800).contains(&r.vertices), "{}", r.vertices);
+    }
+
+    #[test]
+    fn the_result_is_identical_for_1_2_and_8_threads() {
+        let cube = Arc::new(atlas_cube(5));
+        let run = |t| {
+            crate::raster::with_threads(t, || {
+                let r = remesh(&cube, &small(200)).unwrap();
+                (
+                    r.mesh.positions().to_vec(),
+                    r.mesh.uvs().unwrap().to_vec(),
+                    r.mesh.triangles().to_vec(),
+                )
+            })
+            .unwrap()
+        };
+        let one = run(1);
+        assert_eq!(one, run(2));
+        assert_eq!(one, run(8));
+    }
+
+    #[test]
+    fn on_two_density_levels_the_counts_follow_the_integral() {
+        // Error diffusion, then Lloyd weighted with ρ² (see the module comment), on a 1 : 3
+        // density: three quarters of the samples on the dense half.
+        let size = 128;
+        let chart = vec![0u32; size * size];
+        let density: Vec<f32> = (0..size * size)
+            .map(|t| if t % size < 64 { 1.0 } else { 3.0 })
+            .collect();
+        let mut s = sampling::error_diffusion(size, &chart, &density, &[400]);
+        let right = |s: &[Vec2]| s.iter().filter(|p| p.x > 64.0).count();
+        assert!((295..=305).contains(&right(&s[0])), "{}", right(&s[0]));
+        let texels: Vec<u32> = (0..(size * size) as u32).collect();
+        let weights: Vec<f32> = density.iter().map(|d| d * d).collect();
+        lloyd::relax(size, &texels, &weights, &|_| true, &[], &mut s[0], 30);
+        assert!((285..=315).contains(&right(&s[0])), "{}", right(&s[0]));
+    }
+
+    #[test]
+    fn the_masking_map_is_flat_on_a_flat_texture_and_high_on_noise() {
+        let size = 128;
+        let covered = vec![true; size * size];
+        let flat = vec![Vec3::splat(0.4); size * size];
+        let m = masking::masking_map(size, &flat, &covered, 30.0, Display::DEFAULT).unwrap();
+        assert!(m.masking.iter().all(|&v| (v - 1.0).abs() < 1e-3));
+        // The right half noise around the same mean.
+        let mut state = 1u32;
+        let noisy: Vec<Vec3> = (0..size * size)
+            .map(|i| {
+                if i % size < size / 2 {
+                    Vec3::splat(0.4)
+                } else {
+                    state = state.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
+                    Vec3::splat(0.4 + 0.3 * ((state >> 8) as f32 / (1 << 24) as f32 - 0.5))
+                }
+            })
+            .collect();
+        let m = masking::masking_map(size, &noisy, &covered, 30.0, Display::DEFAULT).unwrap();
+        let half = |right: bool| {
+            let v: Vec<f32> = (0..size * size)
+                .filter(|i| {
+                    let x = i % size;
+                    if right {
+                        x >= size / 2 + 16
+                    } else {
+                        x < size / 2 - 16
+                    }
+                })
+                .map(|i| m.masking[i])
+                .collect();
+            v.iter().sum::<f32>() / v.len() as f32
+        };
+        assert!(half(false) < 1.1, "{}", half(false));
+        assert!(
+            half(true) > 2.0 * half(false),
+            "{} {}",
+            half(true),
+            half(false)
+        );
+    }
+
+    #[test]
+    fn overlapping_uv_charts_are_refused() {
+        // Every face of the cube on the same UV square.
+        let cube = atlas_cube(2);
+        let mut data = cube.to_data();
+        data.uvs = Some(
+            data.uvs
+                .unwrap()
+                .iter()
+                .map(|uv| (*uv * 3.0).fract())
+                .collect(),
+        );
+        let m = Arc::new(Mesh::new(data, &LoadOptions::DEFAULT).unwrap());
+        let e = remesh(&m, &small(100)).unwrap_err().to_string();
+        assert!(e.contains("covered by more than one triangle"), "{e}");
+    }
+}

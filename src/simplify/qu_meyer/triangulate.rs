@@ -14,8 +14,8 @@
 //! - Free samples outside the sampled boundary polygon, or within a third of a texel of one of
 //!   its segments, are left out (a vertex on a constraint would split it on one side of a seam
 //!   only).
-//! - A triangle is kept when its centroid lies inside the polygon (even–odd over the chart's
-//!   loops, so holes stay holes); it takes the material of the original triangle under its
+//! - A triangle is kept when it lies inside the polygon: an odd number of constraint edges
+//!   between it and the outside (so holes stay holes); it takes the material of the original triangle under its
 //!   centroid, and its winding follows the chart's (a mirrored chart is wound the other way in
 //!   UV, so its triangles are flipped to face out as the original's do).
 //! - Where a shortened boundary segment would cross another one (a thin or concave chart), the
@@ -216,19 +216,42 @@ pub fn triangulate(
             }
             insert(&mut cdt, uv, Origin::Free(uv)).map_err(Err)?;
         }
-        // Emit the faces inside the chart.
+        // Emit the faces inside the chart: crossing a constraint edge toggles between outside
+        // and inside, starting outside at the convex hull (exact, where a test of a thin
+        // sliver's centroid against the polygon is not).
+        let mut parity: Vec<Option<bool>> = vec![None; cdt.num_all_faces()];
+        let mut queue = std::collections::VecDeque::new();
+        for face in cdt.inner_faces() {
+            for e in face.adjacent_edges() {
+                if e.rev().face().is_outer() && parity[face.fix().index()].is_none() {
+                    parity[face.fix().index()] = Some(e.is_constraint_edge());
+                    queue.push_back(face.fix());
+                }
+            }
+        }
+        while let Some(f) = queue.pop_front() {
+            let here = parity[f.index()].unwrap_or(false);
+            for e in cdt.face(f).adjacent_edges() {
+                if let Some(n) = e.rev().face().as_inner()
+                    && parity[n.fix().index()].is_none()
+                {
+                    parity[n.fix().index()] = Some(here ^ e.is_constraint_edge());
+                    queue.push_back(n.fix());
+                }
+            }
+        }
         let mut index: Vec<u32> = vec![u32::MAX; origin.len()];
         let flip = winding[c] < 0.0;
         for face in cdt.inner_faces() {
+            if parity[face.fix().index()] != Some(true) {
+                continue;
+            }
             let vs = face.vertices();
             let pts = vs.map(|v| {
                 let p = v.position();
                 Vec2::new(p.x as f32, p.y as f32)
             });
             let centroid = (pts[0] + pts[1] + pts[2]) / 3.0;
-            if !inside(centroid, &segments) {
-                continue;
-            }
             let mut tri = [0u32; 3];
             for (k, v) in vs.iter().enumerate() {
                 let h = v.fix().index();
