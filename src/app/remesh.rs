@@ -2,7 +2,7 @@
 //! its curvature-only and uniform baselines), written as OBJ with the input's materials, and the
 //! maps as PNG pictures on request.
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::sync::Arc;
 
 use crate::error::{Error, Result};
@@ -53,14 +53,7 @@ pub struct RemeshReport {
     pub maps: Vec<PathBuf>,
 }
 
-/// The map pictures' file names, in the order they are written.
-pub const MAP_FILES: [&str; 5] = [
-    "signal.png",
-    "masking.png",
-    "curvature.png",
-    "density.png",
-    "samples.png",
-];
+use crate::simplify::qu_meyer::MAP_FILES;
 
 /// Remesh and write.
 pub fn remesh(job: &RemeshJob) -> Result<RemeshReport> {
@@ -87,7 +80,7 @@ pub fn remesh(job: &RemeshJob) -> Result<RemeshReport> {
     let r = qu_meyer::remesh(&input, &options)?;
     mesh::write_obj::write(&r.mesh, &job.out)?;
     if let (Some(dir), Some(images)) = (&job.maps, &r.maps) {
-        write_maps(dir, images)?;
+        images.write(dir)?;
     }
     Ok(RemeshReport {
         file: job.out.clone(),
@@ -104,28 +97,4 @@ pub fn remesh(job: &RemeshJob) -> Result<RemeshReport> {
         seconds: r.seconds,
         maps: map_files,
     })
-}
-
-/// Write the map pictures into `dir` (created if missing).
-pub fn write_maps(dir: &Path, images: &qu_meyer::MapImages) -> Result<()> {
-    std::fs::create_dir_all(dir).map_err(|e| {
-        Error::input(
-            dir,
-            format!("cannot create the maps folder: {e}"),
-            "give a --maps folder you can write to",
-        )
-    })?;
-    for (name, img) in MAP_FILES.iter().zip([
-        &images.signal,
-        &images.masking,
-        &images.curvature,
-        &images.density,
-        &images.samples,
-    ]) {
-        crate::io::write_image(
-            &dir.join(name),
-            &image::DynamicImage::ImageRgb8(img.clone()),
-        )?;
-    }
-    Ok(())
 }

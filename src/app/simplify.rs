@@ -166,6 +166,7 @@ fn lod_file(job: &SimplifyJob, goal: &crate::simplify::Goal) -> PathBuf {
         crate::simplify::Goal::Triangles(t) => format!("t{t}"),
         crate::simplify::Goal::Error(e) => format!("e{e}"),
         crate::simplify::Goal::Distance(d) => format!("d{d}"),
+        crate::simplify::Goal::Vertices(v) => format!("v{v}"),
     };
     job.out.with_file_name(format!("{stem}-{suffix}.obj"))
 }

@@ -54,10 +54,10 @@ pub(crate) struct RemeshArgs {
     #[arg(long, value_enum, default_value_t = RemeshMethodArg::QuMeyer)]
     pub(crate) method: RemeshMethodArg,
     /// Weight of the curvature map (0 to 10; the paper's figures use 1.2).
-    #[arg(long, default_value_t = 1.2)]
+    #[arg(long, default_value_t = 1.2, allow_negative_numbers = true)]
     pub(crate) curvature_gamma: f64,
     /// Weight of the visual masking map (0 to 10; the paper's figures use 1 and 2).
-    #[arg(long, default_value_t = 1.0)]
+    #[arg(long, default_value_t = 1.0, allow_negative_numbers = true)]
     pub(crate) perceptual_gamma: f64,
     /// Lloyd iterations (the paper: 10–20).
     #[arg(long, default_value_t = 20)]

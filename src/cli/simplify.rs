@@ -274,7 +274,7 @@ fn warn_short_of_goals(
         let target = match *g {
             Goal::Ratio(x) => (x * input).round(),
             Goal::Triangles(n) => n as f64,
-            Goal::Error(_) | Goal::Distance(_) => continue,
+            Goal::Error(_) | Goal::Distance(_) | Goal::Vertices(_) => continue,
         };
         if r.triangles as f64 > 1.05 * target + 2.0 {
             note!(

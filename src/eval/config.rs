@@ -444,6 +444,9 @@ pub struct GenerateConfig {
     /// further LODs of the chain.
     #[serde(default)]
     pub distances: Vec<Positive>,
+    /// Vertex counts of remeshes (qu-meyer only), as further LODs of the chain.
+    #[serde(default)]
+    pub vertices: Vec<usize>,
     /// Engine switch distances for the generated LODs, metres, in chain order.
     #[serde(default)]
     pub switch_m: Vec<Positive>,
@@ -726,10 +729,42 @@ impl Config {
                     "list LOD files in `lods` or add `generate = { method = \"meshopt\", ratios = [...] }`",
                 ));
             }
+            if let Some(g) = &a.generate {
+                let qu_meyer = g.method == crate::simplify::Method::QuMeyer;
+                let other = !(g.ratios.is_empty() && g.errors.is_empty() && g.distances.is_empty());
+                if qu_meyer != !g.vertices.is_empty() || (qu_meyer && other) {
+                    return Err(fail(
+                        &quoted,
+                        format!(
+                            "asset '{}': generate method {} {}",
+                            a.name.0,
+                            g.method.name(),
+                            if qu_meyer {
+                                "remeshes to vertex counts only"
+                            } else {
+                                "takes no vertex counts; those are for qu-meyer"
+                            }
+                        ),
+                        "use `generate = { method = \"qu-meyer\", vertices = [2000, 1000] }` \
+                         for remeshes, ratios or errors for the simplifiers",
+                    ));
+                }
+                if let Some(v) = g.vertices.iter().find(|&&v| v < 4) {
+                    return Err(fail(
+                        &quoted,
+                        format!(
+                            "asset '{}': generate vertices {v}: a remesh needs at least 4",
+                            a.name.0
+                        ),
+                        "give vertex counts of 4 or more",
+                    ));
+                }
+            }
             if let Some(g) = &a.generate
                 && g.ratios.is_empty()
                 && g.errors.is_empty()
                 && g.distances.is_empty()
+                && g.vertices.is_empty()
             {
                 return Err(fail(
                     &quoted,
@@ -774,6 +809,11 @@ impl Config {
                     g.distances.iter().map(|d| d.0).collect(),
                     |a, b| b > a,
                     "distances must increase",
+                ))
+                .or(pair(
+                    g.vertices.iter().map(|&v| v as f64).collect(),
+                    |a, b| b < a,
+                    "vertex counts must decrease",
                 ));
                 if let Some((first, then, what)) = bad {
                     return Err(fail(
@@ -786,7 +826,7 @@ impl Config {
                         "order them from the finest LOD to the coarsest, e.g. ratios = [0.5, 0.25]",
                     ));
                 }
-                let lods = g.ratios.len() + g.errors.len() + g.distances.len();
+                let lods = g.ratios.len() + g.errors.len() + g.distances.len() + g.vertices.len();
                 if g.switch_m.len() > lods {
                     return Err(fail(
                         &quoted,
@@ -864,6 +904,12 @@ impl Config {
                 out.push((
                     format!("{}-d{}", g.method.name(), d.0),
                     base + g.ratios.len() + g.errors.len() + k,
+                ));
+            }
+            for (k, v) in g.vertices.iter().enumerate() {
+                out.push((
+                    format!("{}-v{v}", g.method.name()),
+                    base + g.ratios.len() + g.errors.len() + g.distances.len() + k,
                 ));
             }
         }

@@ -40,6 +40,8 @@ pub enum GenTarget {
     Error(f64),
     /// Viewing distance in metres (menzel-guthe).
     Distance(f64),
+    /// Vertices of a remesh (qu-meyer).
+    Vertices(usize),
 }
 
 impl GenTarget {
@@ -49,6 +51,7 @@ impl GenTarget {
             GenTarget::Ratio(r) => Goal::Ratio(r),
             GenTarget::Error(e) => Goal::Error(e),
             GenTarget::Distance(d) => Goal::Distance(d),
+            GenTarget::Vertices(v) => Goal::Vertices(v),
         }
     }
 }
@@ -210,7 +213,8 @@ impl Plan {
                     .iter()
                     .map(|r| GenTarget::Ratio(r.0))
                     .chain(g.errors.iter().map(|e| GenTarget::Error(e.0)))
-                    .chain(g.distances.iter().map(|d| GenTarget::Distance(d.0)));
+                    .chain(g.distances.iter().map(|d| GenTarget::Distance(d.0)))
+                    .chain(g.vertices.iter().map(|&v| GenTarget::Vertices(v)));
                 for (step, target) in targets.enumerate() {
                     lods.push(LodPlan {
                         name: names[a.lods.len() + step].0.clone(),

@@ -334,6 +334,9 @@ pub fn build_lods(
                     GenTarget::Distance(d) => {
                         format!("{} distance {d} m (chain step {})", method.name(), step + 1)
                     }
+                    GenTarget::Vertices(v) => {
+                        format!("{} {v} vertices (chain step {})", method.name(), step + 1)
+                    }
                 };
                 (l.mesh, what, l.error.map(round7))
             }

@@ -50,6 +50,9 @@ pub struct Experiment {
     /// γ_p for the qu-meyer method.
     #[serde(default = "default_perceptual_gamma")]
     pub perceptual_gamma: f64,
+    /// Also remesh with the masking map's pattern term alone (TVI weight 0), as `qu-meyer-pattern`.
+    #[serde(default)]
+    pub pattern_only: bool,
     /// The models.
     pub model: Vec<ModelSpec>,
 }
@@ -144,7 +147,7 @@ pub fn run(config: &Path, log: &mut dyn FnMut(&str)) -> Result<Report> {
     struct Made {
         model: String,
         budget: usize,
-        method: Method,
+        label: &'static str,
         vertices: usize,
         triangles: usize,
         masked_share: f64,
@@ -157,20 +160,30 @@ pub fn run(config: &Path, log: &mut dyn FnMut(&str)) -> Result<Report> {
         let input = Arc::new(mesh::load(&path, &LoadOptions::default())?);
         let mut lods = Vec::new();
         for (k, &budget) in m.vertices.iter().enumerate() {
-            for method in Method::ALL.iter().rev().copied() {
+            // (label, method, TVI weight)
+            let mut variants: Vec<(&str, Method, f64)> = vec![
+                ("uniform", Method::Uniform, 0.5),
+                ("curvature", Method::Curvature, 0.5),
+                ("qu-meyer", Method::QuMeyer, 0.5),
+            ];
+            if exp.pattern_only {
+                variants.push(("qu-meyer-pattern", Method::QuMeyer, 0.0));
+            }
+            for (label, method, tvi_weight) in variants {
                 let mut options = Options::new(budget);
                 options.method = method;
                 options.curvature_gamma = exp.curvature_gamma;
                 options.perceptual_gamma = exp.perceptual_gamma;
-                options.keep_maps = k == 0 && method == Method::QuMeyer;
+                options.tvi_weight = tvi_weight;
+                options.keep_maps = k == 0 && label == "qu-meyer";
                 let start = std::time::Instant::now();
                 let r = qu_meyer::remesh(&input, &options)?;
                 let seconds = start.elapsed().as_secs_f64();
-                let name = format!("{}-{}", method.name(), budget);
+                let name = format!("{label}-{budget}");
                 let file = meshes_dir.join(format!("{}-{name}.obj", m.name));
                 mesh::write_obj::write(&r.mesh, &file)?;
                 if let Some(images) = &r.maps {
-                    crate::app::remesh::write_maps(&out.join("maps").join(&m.name), images)?;
+                    images.write(&out.join("maps").join(&m.name))?;
                 }
                 log(&format!(
                     "{} {}: {} vertices, {} triangles, {:.0} % in the most masked quarter, {:.2} s",
@@ -188,7 +201,7 @@ pub fn run(config: &Path, log: &mut dyn FnMut(&str)) -> Result<Report> {
                 made.push(Made {
                     model: m.name.clone(),
                     budget,
-                    method,
+                    label,
                     vertices: r.vertices,
                     triangles: r.mesh.triangle_count(),
                     masked_share: r.masked_share,
@@ -228,11 +241,11 @@ pub fn run(config: &Path, log: &mut dyn FnMut(&str)) -> Result<Report> {
     let rows: Vec<Row> = made
         .iter()
         .map(|m| {
-            let lod = format!("{}-{}", m.method.name(), m.budget);
+            let lod = format!("{}-{}", m.label, m.budget);
             Row {
                 model: m.model.clone(),
                 budget: m.budget,
-                method: m.method.name().to_string(),
+                method: m.label.to_string(),
                 vertices: m.vertices,
                 triangles: m.triangles,
                 masked_share: m.masked_share,

@@ -54,6 +54,10 @@ pub enum Method {
     /// distance beyond which each is invisible (`menzel_guthe/`).
     #[serde(rename = "menzel-guthe")]
     MenzelGuthe,
+    /// Qu & Meyer: a remesh of a textured mesh to a vertex count, placed by curvature and the
+    /// visual masking of its surface signal (`qu_meyer/`; vertex goals only).
+    #[serde(rename = "qu-meyer")]
+    QuMeyer,
 }
 
 impl Method {
@@ -66,6 +70,7 @@ impl Method {
             Method::MeshoptUpdate => "meshopt-update",
             Method::Williams => "williams",
             Method::MenzelGuthe => "menzel-guthe",
+            Method::QuMeyer => "qu-meyer",
         }
     }
 }
@@ -81,6 +86,8 @@ pub enum Goal {
     Error(f64),
     /// Imperceptible from this viewing distance on, metres (menzel-guthe only).
     Distance(f64),
+    /// A remesh with this many vertices (qu-meyer only).
+    Vertices(usize),
 }
 
 impl std::fmt::Display for Goal {
@@ -90,6 +97,7 @@ impl std::fmt::Display for Goal {
             Goal::Triangles(t) => write!(f, "{t} triangles"),
             Goal::Error(e) => write!(f, "error {e}"),
             Goal::Distance(d) => write!(f, "distance {d} m"),
+            Goal::Vertices(v) => write!(f, "{v} vertices"),
         }
     }
 }
@@ -197,6 +205,15 @@ pub fn chain_scaled(
     meters_per_unit: f64,
 ) -> Result<Vec<Lod>> {
     check_goals(mesh.triangle_count(), goals)?;
+    let vertex_goal = goals.iter().find(|g| matches!(g, Goal::Vertices(_)));
+    if method == Method::QuMeyer {
+        return qu_meyer_chain(mesh, goals);
+    } else if let Some(g) = vertex_goal {
+        return Err(Error::Usage(format!(
+            "{} takes ratio, triangle or error goals, not {g}; a vertex goal is for qu-meyer",
+            method.name()
+        )));
+    }
     if method != Method::MenzelGuthe
         && let Some(d) = goals.iter().find(|g| matches!(g, Goal::Distance(_)))
     {
@@ -245,6 +262,11 @@ pub fn check_goals(triangles: usize, goals: &[Goal]) -> Result<()> {
                      give a smaller count, or --ratio"
                 )));
             }
+            Goal::Vertices(v) => {
+                crate::limits::REMESH_VERTICES
+                    .check("vertices", v as u64)
+                    .map_err(Error::Usage)?;
+            }
             _ => {}
         }
     }
@@ -254,6 +276,7 @@ pub fn check_goals(triangles: usize, goals: &[Goal]) -> Result<()> {
             (Goal::Triangles(a), Goal::Triangles(b)) => b < a,
             (Goal::Error(a), Goal::Error(b)) => b > a,
             (Goal::Distance(a), Goal::Distance(b)) => b > a,
+            (Goal::Vertices(a), Goal::Vertices(b)) => b < a,
             _ => true,
         };
         if !coarser {
@@ -280,6 +303,26 @@ pub fn menzel_guthe_goals(triangles: usize, goals: &[Goal]) -> Vec<menzel_guthe:
             Goal::Triangles(t) => menzel_guthe::Goal::Triangles(t),
             Goal::Error(e) => menzel_guthe::Goal::Error(e),
             Goal::Distance(d) => menzel_guthe::Goal::Distance(d),
+            // Refused before: chain_scaled sends vertex goals to qu-meyer only.
+            Goal::Vertices(v) => menzel_guthe::Goal::Triangles(v.clamp(1, triangles)),
+        })
+        .collect()
+}
+
+/// Qu & Meyer's chain: each LOD remeshed from the original to its vertex count, with the
+/// method's defaults.
+fn qu_meyer_chain(mesh: &Mesh, goals: &[Goal]) -> Result<Vec<Lod>> {
+    let shared = std::sync::Arc::new(mesh.clone());
+    goals
+        .iter()
+        .map(|g| match *g {
+            Goal::Vertices(v) => Ok(Lod {
+                mesh: qu_meyer::remesh(&shared, &qu_meyer::Options::new(v))?.mesh,
+                error: None,
+            }),
+            other => Err(Error::Usage(format!(
+                "qu-meyer remeshes to a vertex count (`vertices = [...]`), not to {other}"
+            ))),
         })
         .collect()
 }
@@ -306,10 +349,11 @@ fn chain_of(mesh: &Mesh, method: Method, goals: &[Goal]) -> Result<Vec<Lod>> {
     let tris = |g: Goal| match g {
         Goal::Ratio(r) => Some((n as f64 * r).round().max(1.0) as usize),
         Goal::Triangles(t) => Some(t),
-        Goal::Error(_) | Goal::Distance(_) => None,
+        Goal::Error(_) | Goal::Distance(_) | Goal::Vertices(_) => None,
     };
     match method {
         Method::MenzelGuthe => menzel_guthe_chain(mesh, goals, 1.0),
+        Method::QuMeyer => qu_meyer_chain(mesh, goals),
         Method::Meshopt | Method::MeshoptUpdate => {
             let mut out: Vec<Lod> = Vec::new();
             for &g in goals {

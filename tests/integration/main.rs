@@ -14,6 +14,8 @@
 //!   distances, thread independence, the eval generator, bad requests.
 //! - `optimize`: `lodeval optimize` (Lindstrom–Turk): energy goes down, the vertex count stays,
 //!   the output is identical for 1, 2 and 8 threads; bad input exits 2.
+//! - `qu_meyer`: `lodeval remesh` (Qu & Meyer): the remesh, its maps and JSON, thread
+//!   independence, the eval generator, the experiment on a tiny config, bad requests.
 //! - `oracles`: metrics against reference implementations (FLIP: NVIDIA's; SSIM/PSNR: scikit-image).
 //! - `raster`: the CPU rasterizer (determinism over thread counts, watertightness, golden images,
 //!   the `render` CLI).
@@ -35,6 +37,7 @@ mod menzel_guthe;
 mod models;
 mod optimize;
 mod oracles;
+mod qu_meyer;
 mod raster;
 mod simplify;
 mod vdp;

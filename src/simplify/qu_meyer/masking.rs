@@ -9,7 +9,7 @@
 //! Their metric is the Sarnoff VDM; ours is lodeval's calibrated VDP (`metric::vdp`), whose stage
 //! 5 gives per band the threshold elevation of a masker of known JND.
 //!
-//! The map, per texel: M = ½·E_pattern + ½·E_tvi, where
+//! The map, per texel: M = (1 − w)·E_pattern + w·E_tvi with w = ½ by default, where
 //! - E_pattern ≥ 1 is the largest threshold elevation over the VDP's bands that the signal's
 //!   detail (signal minus its low pass, band by band, local magnitude in JND) gives
 //!   (`Vdp::masking_against`);
@@ -19,7 +19,8 @@
 //!   samples than do darker surface features").
 //!
 //! A uniform signal gives M = 1 everywhere (no masking). The weights are ours (the paper gives
-//! none); both terms are threshold multipliers, so their mean is one too.
+//! none); both terms are threshold multipliers, so any mix of them is one too. w = 0 keeps the
+//! pattern term alone (the experiment measures both).
 //!
 //! Decisions: the map is seen one texel per display pixel at the configured pixels per degree;
 //! the low pass's σ is 1/6 of a degree (its ±3σ kernel spans the paper's one degree). Texels no
@@ -79,13 +80,14 @@ fn weighted_blur(
 }
 
 /// The masking map of the signal `signal` (linear RGB, `size × size`), covered where `covered`,
-/// seen at `ppd` pixels per degree on `display`.
+/// seen at `ppd` pixels per degree on `display`, the TVI term weighted `tvi_weight` (0 to 1).
 pub fn masking_map(
     size: usize,
     signal: &[Vec3],
     covered: &[bool],
     ppd: f64,
     display: Display,
+    tvi_weight: f32,
 ) -> Result<MaskingMap> {
     let n = size * size;
     let weight: Vec<f32> = covered.iter().map(|&c| f32::from(u8::from(c))).collect();
@@ -133,7 +135,7 @@ pub fn masking_map(
     let masking = (0..n)
         .map(|i| {
             if covered[i] {
-                0.5 * (pattern[i] + tvi_map[i])
+                (1.0 - tvi_weight) * pattern[i] + tvi_weight * tvi_map[i]
             } else {
                 1.0
             }

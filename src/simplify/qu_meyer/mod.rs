@@ -91,6 +91,9 @@ pub struct Options {
     pub lloyd_iterations: usize,
     /// Texels per side of the maps. Default value: 512 (the paper's Figure 5).
     pub map_size: usize,
+    /// Weight of the threshold-vs-intensity term in the masking map, 0 to 1 (the rest is the
+    /// pattern term). Default value: 0.5.
+    pub tvi_weight: f64,
     /// Pixels per degree the map is seen at (one texel per pixel). Default value: the default
     /// display's (0.7 m wide, 3840 px, seen from 0.7 m: about 67).
     pub ppd: f64,
@@ -110,6 +113,7 @@ impl Options {
             perceptual_gamma: 1.0,
             lloyd_iterations: 20,
             map_size: 512,
+            tvi_weight: 0.5,
             ppd: Viewing::DEFAULT.ppd(),
             display: Display::DEFAULT,
             keep_maps: false,
@@ -138,6 +142,12 @@ impl Options {
                     REMESH_GAMMA.max
                 )));
             }
+        }
+        if !(0.0..=1.0).contains(&self.tvi_weight) {
+            return Err(Error::Usage(format!(
+                "TVI weight {}: a weight from 0 to 1",
+                self.tvi_weight
+            )));
         }
         REMESH_VERTICES
             .check("--vertices", self.vertices as u64)
@@ -177,6 +187,41 @@ pub struct MapImages {
     pub density: image::RgbImage,
     /// The final samples over the density (boundary vertices in cyan, free ones in white).
     pub samples: image::RgbImage,
+}
+
+/// The map pictures' file names, in the order [`MapImages::write`] writes them.
+pub const MAP_FILES: [&str; 5] = [
+    "signal.png",
+    "masking.png",
+    "curvature.png",
+    "density.png",
+    "samples.png",
+];
+
+impl MapImages {
+    /// Write the pictures into `dir` (created if missing) as [`MAP_FILES`].
+    pub fn write(&self, dir: &std::path::Path) -> Result<()> {
+        std::fs::create_dir_all(dir).map_err(|e| {
+            Error::input(
+                dir,
+                format!("cannot create the maps folder: {e}"),
+                "give a --maps folder you can write to",
+            )
+        })?;
+        for (name, img) in MAP_FILES.iter().zip([
+            &self.signal,
+            &self.masking,
+            &self.curvature,
+            &self.density,
+            &self.samples,
+        ]) {
+            crate::io::write_image(
+                &dir.join(name),
+                &image::DynamicImage::ImageRgb8(img.clone()),
+            )?;
+        }
+        Ok(())
+    }
 }
 
 /// A remesh and what it took.
@@ -239,22 +284,20 @@ pub fn remesh(mesh: &Arc<Mesh>, options: &Options) -> Result<Remesh> {
     let t = Instant::now();
     let covered: Vec<bool> = maps.chart.iter().map(|&c| c != u32::MAX).collect();
     let (gc, gp) = options.gammas();
-    let masking = if gp != 0.0 || options.keep_maps || options.method == Method::QuMeyer {
-        Some(masking::masking_map(
-            ts.size,
-            &ts.signal,
-            &covered,
-            options.ppd,
-            options.display,
-        )?)
-    } else {
-        None
-    };
+    // Computed for every method: the uniform and curvature remeshes are judged by where their
+    // vertices fall on it too.
+    let masking = masking::masking_map(
+        ts.size,
+        &ts.signal,
+        &covered,
+        options.ppd,
+        options.display,
+        options.tvi_weight as f32,
+    )?;
     seconds.masking = t.elapsed().as_secs_f64();
 
     let t = Instant::now();
-    let ones = vec![1.0f32; ts.size * ts.size];
-    let m = masking.as_ref().map_or(&ones, |m| &m.masking);
+    let m = &masking.masking;
     let density = Density::new(&maps.curvature, m, &maps, charts.count, (gc, gp));
     let welded = welded_positions(mesh);
     let representative = representative_texels(mesh, &ts);
@@ -339,7 +382,7 @@ pub fn remesh(mesh: &Arc<Mesh>, options: &Options) -> Result<Remesh> {
     let masked_share = masked_share(&out, &ts, &maps, m);
     let images = options
         .keep_maps
-        .then(|| map_images(&ts, &maps, masking.as_ref(), &density, &out));
+        .then(|| map_images(&ts, &maps, &masking, &density, &out));
     Ok(Remesh {
         vertices: out.welded_vertex_count(),
         boundary_vertices: keep.iter().filter(|&&k| k).count(),
@@ -457,7 +500,7 @@ fn masked_share(out: &Mesh, ts: &TextureSpace, maps: &Maps, masking: &[f32]) -> 
 fn map_images(
     ts: &TextureSpace,
     maps: &Maps,
-    masking: Option<&masking::MaskingMap>,
+    masking: &masking::MaskingMap,
     density: &Density,
     out: &Mesh,
 ) -> MapImages {
@@ -487,22 +530,16 @@ fn map_images(
         [c.x, c.y, c.z]
             .map(|v| (crate::color::linear_to_srgb(v.clamp(0.0, 1.0)) * 255.0).round() as u8)
     });
-    let masking_img = match masking {
-        Some(m) => {
-            // log M: 1 (none) black, the strongest white.
-            let l: Vec<f32> = m.masking.iter().map(|v| v.max(1e-6).ln()).collect();
-            let hi = (0..l.len())
-                .filter(|&i| covered(i))
-                .map(|i| l[i])
-                .fold(1e-6f32, f32::max);
-            let lo = (0..l.len())
-                .filter(|&i| covered(i))
-                .map(|i| l[i])
-                .fold(0.0f32, f32::min);
-            to_rgb(&|i| [(((l[i] - lo) / (hi - lo)).clamp(0.0, 1.0) * 255.0) as u8; 3])
-        }
-        None => to_rgb(&|_| [0, 0, 0]),
-    };
+    // log M: the least masked texel black, the strongest white.
+    let l: Vec<f32> = masking.masking.iter().map(|v| v.max(1e-6).ln()).collect();
+    let (lo, hi) = (0..l.len())
+        .filter(|&i| covered(i))
+        .fold((f32::MAX, f32::MIN), |(a, b), i| (a.min(l[i]), b.max(l[i])));
+    let masking_img = to_rgb(&|i| {
+        [((l[i] - lo) / (hi - lo).max(1e-6))
+            .clamp(0.0, 1.0)
+            .mul_add(255.0, 0.0) as u8; 3]
+    });
     let curvature = scaled(&maps.curvature);
     let density_img = scaled(&density.domain);
     let mut samples = density_img.clone();
@@ -745,7 +782,7 @@ mod tests {
         let size = 128;
         let covered = vec![true; size * size];
         let flat = vec![Vec3::splat(0.4); size * size];
-        let m = masking::masking_map(size, &flat, &covered, 30.0, Display::DEFAULT).unwrap();
+        let m = masking::masking_map(size, &flat, &covered, 30.0, Display::DEFAULT, 0.5).unwrap();
         assert!(m.masking.iter().all(|&v| (v - 1.0).abs() < 1e-3));
         // The right half noise around the same mean.
         let mut state = 1u32;
@@ -759,7 +796,7 @@ mod tests {
                 }
             })
             .collect();
-        let m = masking::masking_map(size, &noisy, &covered, 30.0, Display::DEFAULT).unwrap();
+        let m = masking::masking_map(size, &noisy, &covered, 30.0, Display::DEFAULT, 0.5).unwrap();
         let half = |right: bool| {
             let v: Vec<f32> = (0..size * size)
                 .filter(|i| {
