@@ -732,7 +732,7 @@ impl Config {
             if let Some(g) = &a.generate {
                 let qu_meyer = g.method == crate::simplify::Method::QuMeyer;
                 let other = !(g.ratios.is_empty() && g.errors.is_empty() && g.distances.is_empty());
-                if qu_meyer != !g.vertices.is_empty() || (qu_meyer && other) {
+                if qu_meyer == g.vertices.is_empty() || (qu_meyer && other) {
                     return Err(fail(
                         &quoted,
                         format!(
