@@ -15,6 +15,7 @@ macro_rules! note {
 mod args;
 mod bench;
 mod calibrate;
+mod compare;
 mod diff;
 mod eval;
 mod geometry;
@@ -58,6 +59,9 @@ enum Command {
     Render(render::RenderArgs),
     /// Compare two images with the perceptual metrics.
     Diff(diff::DiffArgs),
+    /// Compare two meshes: both rendered from the original's framing, every view scored, the
+    /// imperceptibility distances (no config).
+    Compare(compare::CompareArgs),
     /// Run a batch evaluation config: render, score, write CSVs, heat maps, report; gate.
     Eval(eval::EvalArgs),
     /// Compare renders with golden images, or bless new ones.
@@ -94,6 +98,7 @@ pub(crate) fn run(cli: Cli) -> Result<(), Error> {
         Command::Info(a) => info::run(a),
         Command::Render(a) => render::run(a, quiet),
         Command::Diff(a) => diff::run(a),
+        Command::Compare(a) => compare::run(a, quiet),
         Command::Eval(a) => eval::run(a, quiet),
         Command::Golden(a) => golden::run(a),
         Command::Simplify(a) => simplify::run(a, quiet),

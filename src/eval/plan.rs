@@ -146,7 +146,7 @@ impl Plan {
     /// second asset used to fail after the first was done). The message gives the line and
     /// where the path led, relative to the config's folder. Not part of [`Plan::from_text`]:
     /// `merge` rebuilds plans of runs made on other machines.
-    fn check_meshes(&self) -> Result<()> {
+    pub(crate) fn check_meshes(&self) -> Result<()> {
         let written = self.config.assets.iter().flat_map(|a| {
             std::iter::once((a, &a.mesh)).chain(a.lods.iter().map(move |l| (a, &l.mesh)))
         });

@@ -77,6 +77,24 @@ pub fn run(plan: Plan, options: &RunOptions, progress: &dyn Progress) -> Result<
         .out_dir(&plan.config_path, options.out.as_deref());
     // Before anything is rendered: the folder is lodeval's, and an earlier run's outputs go.
     super::out::prepare(&out_dir, super::out::EVAL, &plan.input_files())?;
+    let (results, warnings) = evaluate(&plan, options, progress, Some(&out_dir))?;
+    Ok(RunOutput {
+        plan,
+        out_dir,
+        results,
+        warnings,
+    })
+}
+
+/// Render and score every wanted case of `plan`: the tables and the warnings. Heat maps and
+/// contact sheets go into `images` where it is given (`lodeval compare` gives none and writes
+/// nothing).
+pub fn evaluate(
+    plan: &Plan,
+    options: &RunOptions,
+    progress: &dyn Progress,
+    images: Option<&Path>,
+) -> Result<(Results, Vec<String>)> {
     let cfg = &plan.config;
     let viewing = cfg.viewing.viewing();
     let scorer = Scorer::new(
@@ -150,9 +168,11 @@ pub fn run(plan: Plan, options: &RunOptions, progress: &dyn Progress) -> Result<
                 .map(|(lod, lod_renderer)| -> Result<_> {
                     let test_frame = lod_renderer.render(camera, &settings)?;
                     let scored = scorer.score(&prepared, &LinearImage::from(&test_frame))?;
-                    if cfg.images.heatmaps == HeatmapChoice::All {
+                    if let Some(out_dir) = images
+                        && cfg.images.heatmaps == HeatmapChoice::All
+                    {
                         for (metric, map) in &scored.maps {
-                            write_heat_map(&out_dir, &asset.name, &lod.name, v, metric, map)?;
+                            write_heat_map(out_dir, &asset.name, &lod.name, v, metric, map)?;
                         }
                     }
                     let thumbs = scored.maps.first().map(|(metric, map)| {
@@ -197,7 +217,8 @@ pub fn run(plan: Plan, options: &RunOptions, progress: &dyn Progress) -> Result<
         }
         for (k, lod) in lods.iter().enumerate() {
             let order = worst_first(&results, &asset.name, &lod.name, &cfg.metrics);
-            if cfg.images.heatmaps == HeatmapChoice::Worst
+            if let Some(out_dir) = images
+                && cfg.images.heatmaps == HeatmapChoice::Worst
                 && let Some(&worst) = order.first()
             {
                 // Re-render the worst view only, for its heat maps.
@@ -205,10 +226,13 @@ pub fn run(plan: Plan, options: &RunOptions, progress: &dyn Progress) -> Result<
                 let b = LinearImage::from(&lod_renderers[k].render(&cameras[worst], &settings)?);
                 let scored = scorer.score(&scorer.prepare(a), &b)?;
                 for (metric, map) in &scored.maps {
-                    write_heat_map(&out_dir, &asset.name, &lod.name, worst, metric, map)?;
+                    write_heat_map(out_dir, &asset.name, &lod.name, worst, metric, map)?;
                 }
             }
-            if cfg.images.contact_sheets && !sheets[k].is_empty() {
+            if let Some(out_dir) = images
+                && cfg.images.contact_sheets
+                && !sheets[k].is_empty()
+            {
                 let mut tiles = Vec::new();
                 for &v in order.iter().take(cfg.images.sheet_views.max(1)) {
                     if let Some((_, t)) = sheets[k].iter().find(|(view, _)| *view == v) {
@@ -254,12 +278,10 @@ pub fn run(plan: Plan, options: &RunOptions, progress: &dyn Progress) -> Result<
     }
     bar.finish();
     results.sort(&plan.case_ids());
-    Ok(RunOutput {
-        plan,
-        out_dir,
+    Ok((
         results,
-        warnings: engine.fallback().map(str::to_string).into_iter().collect(),
-    })
+        engine.fallback().map(str::to_string).into_iter().collect(),
+    ))
 }
 
 /// A scene of `mesh` with the config's lights, background and ambient term.

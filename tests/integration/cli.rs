@@ -215,3 +215,78 @@ fn diff_rejects_bad_requests_with_exit_2() {
         0
     );
 }
+
+#[test]
+fn compare_scores_what_eval_scores_for_the_same_views() {
+    let dir = tempfile::tempdir().unwrap();
+    let original = model("bunny/bunny_odedstein_3k.obj");
+    let lod = dir.path().join("lod.obj");
+    let r = crate::common::simplify(&original, &lod, &["--ratio", "0.3"]);
+    assert_eq!(r.code, 0, "{}", r.stderr);
+    let r = lodeval([
+        "compare",
+        original.to_str().unwrap(),
+        lod.to_str().unwrap(),
+        "--views",
+        "12",
+        "--size",
+        "96",
+        "--no-distances",
+        "--json",
+    ]);
+    assert_eq!(r.code, 0, "{}", r.stderr);
+    let j: serde_json::Value = serde_json::from_str(&r.stdout).unwrap();
+    let views = j["views"].as_array().unwrap();
+    assert_eq!(views.iter().filter(|v| v["metric"] == "flip").count(), 12);
+    // The same plan as a config file: the same values, view by view.
+    let cfg = dir.path().join("c.toml");
+    std::fs::write(
+        &cfg,
+        format!(
+            "out = \"out\"\n[render]\nsize = 96\nrig = \"icosahedron\"\n[distance]\nenabled = false\n\
+             [images]\nheatmaps = \"none\"\ncontact_sheets = false\n[[asset]]\nname = \"a\"\nmesh = \"{}\"\n\
+             lods = [{{ mesh = \"{}\", name = \"l\" }}]\n",
+            original.display(),
+            lod.display()
+        ),
+    )
+    .unwrap();
+    let r = lodeval(["eval", cfg.to_str().unwrap(), "-q"]);
+    assert!(r.code == 0 || r.code == 1, "{}", r.stderr);
+    let csv = std::fs::read_to_string(dir.path().join("out/metrics.csv")).unwrap();
+    let mut checked = 0;
+    for line in csv.lines().skip(1) {
+        let f: Vec<&str> = line.split(',').collect();
+        let (view, metric, value): (u64, &str, f64) =
+            (f[3].parse().unwrap(), f[4], f[5].parse().unwrap());
+        let mine = views
+            .iter()
+            .find(|v| v["view"].as_u64() == Some(view) && v["metric"] == metric)
+            .unwrap_or_else(|| panic!("{metric} of view {view} missing"))["value"]
+            .as_f64()
+            .unwrap();
+        assert_eq!(mine, value, "{metric}, view {view}");
+        checked += 1;
+    }
+    assert!(checked >= 12 * 4, "{checked}");
+    // The text table names every view, the mean and the worst.
+    let r = lodeval([
+        "compare",
+        original.to_str().unwrap(),
+        lod.to_str().unwrap(),
+        "--views",
+        "3",
+        "--size",
+        "64",
+        "--no-distances",
+    ]);
+    assert_eq!(r.code, 0, "{}", r.stderr);
+    assert!(
+        r.stdout.contains(" mean ") && r.stdout.contains("worst"),
+        "{}",
+        r.stdout
+    );
+    // A missing mesh is an input error.
+    let r = lodeval(["compare", original.to_str().unwrap(), "/nonexistent/x.obj"]);
+    assert_eq!(r.code, 2, "{}", r.stderr);
+}
