@@ -66,6 +66,97 @@ pub struct DiffResult {
     pub note: Option<String>,
     /// Where the metric ran: `cpu`, or `gpu: ADAPTER …` for FLIP, MSE and PSNR on the GPU.
     pub backend: String,
+    /// For metrics with a per-pixel map (FLIP error, 1 − SSIM, the VDP's detection probability):
+    /// the worst pixel, first in row order where several are equally bad.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub worst_pixel: Option<WorstPixel>,
+    /// With a per-pixel threshold: the share of pixels (0–1) whose map value exceeds it.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub share_over: Option<f64>,
+}
+
+/// The worst pixel of a per-pixel map.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+pub struct WorstPixel {
+    /// Column, from the left.
+    pub x: usize,
+    /// Row, from the top.
+    pub y: usize,
+    /// The map's value there (larger is worse).
+    pub value: f64,
+}
+
+impl DiffMetric {
+    /// The name on the command line and in outputs.
+    pub fn name(self) -> &'static str {
+        match self {
+            DiffMetric::Flip => "flip",
+            DiffMetric::Ssim => "ssim",
+            DiffMetric::Msssim => "msssim",
+            DiffMetric::Psnr => "psnr",
+            DiffMetric::Mse => "mse",
+            DiffMetric::Vdp => "vdp",
+        }
+    }
+
+    /// Whether a larger value means a larger difference (FLIP, MSE, the VDP) rather than a
+    /// smaller one (SSIM, MS-SSIM, PSNR).
+    pub fn larger_is_worse(self) -> bool {
+        matches!(self, DiffMetric::Flip | DiffMetric::Mse | DiffMetric::Vdp)
+    }
+}
+
+/// Pass/warn/fail limits on one metric, as idiff and NVIDIA's FLIP tool take them.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct DiffGates {
+    /// Fail when the pooled value is worse than this.
+    pub fail: Option<f64>,
+    /// Warn when the pooled value is worse than this.
+    pub warn: Option<f64>,
+    /// Fail when more than this percentage of pixels exceed `pixel`.
+    pub fail_percent: Option<f64>,
+    /// Warn when more than this percentage of pixels exceed `pixel`.
+    pub warn_percent: Option<f64>,
+    /// The per-pixel threshold of the percentage gates (on the metric's map, larger is worse).
+    pub pixel: Option<f64>,
+}
+
+/// What the gates say of one result: `None` when it passes, else the reason.
+pub fn judge(r: &DiffResult, gates: &DiffGates) -> (Option<String>, Option<String>) {
+    let worse = |v: f64, limit: f64| {
+        if r.metric.larger_is_worse() {
+            v > limit
+        } else {
+            v < limit
+        }
+    };
+    let name = r.metric.name();
+    let over = |limit: Option<f64>, verb: &str| -> Option<String> {
+        let (limit, v) = (limit?, r.value?);
+        worse(v, limit).then(|| {
+            format!(
+                "{name} {v:.6} is {} the {verb} limit {limit}",
+                if r.metric.larger_is_worse() {
+                    "above"
+                } else {
+                    "below"
+                }
+            )
+        })
+    };
+    let share = |limit: Option<f64>, verb: &str| -> Option<String> {
+        let (limit, s) = (limit?, r.share_over?);
+        (100.0 * s > limit).then(|| {
+            format!(
+                "{:.3} % of pixels have {name} above {}, more than the {verb} limit of {limit} %",
+                100.0 * s,
+                gates.pixel.unwrap_or(0.0)
+            )
+        })
+    };
+    let fail = over(gates.fail, "fail").or_else(|| share(gates.fail_percent, "fail"));
+    let warn = over(gates.warn, "warn").or_else(|| share(gates.warn_percent, "warn"));
+    (fail, warn)
 }
 
 /// Where and on what the compared images are seen.
@@ -81,6 +172,7 @@ pub struct Seen {
 /// (`map` itself for one metric with a map, `STEM-METRIC.png` beside it for several). With
 /// `lenient`, a metric that does not apply to images of this size (SSIM below 11×11, MS-SSIM
 /// below 176×176) is reported without a value and with a note instead of failing the command.
+/// With `pixel_threshold`, each per-pixel map also gives the share of pixels above it.
 pub fn diff(
     engine: &crate::backend::Engine,
     reference: &Path,
@@ -89,6 +181,7 @@ pub fn diff(
     seen: &Seen,
     map: Option<&Path>,
     lenient: bool,
+    pixel_threshold: Option<f64>,
 ) -> Result<Vec<DiffResult>> {
     use crate::metric::{LinearImage, colormap, flip::Flip, pool, ssim};
     let (a, b) = (LinearImage::load(reference)?, LinearImage::load(test)?);
@@ -146,7 +239,11 @@ pub fn diff(
                 DiffMetric::Flip | DiffMetric::Mse | DiffMetric::Psnr => engine.describe(),
                 _ => crate::backend::CPU_RENDERER.to_string(),
             },
+            worst_pixel: None,
+            share_over: None,
         };
+        // The metric's per-pixel map, larger is worse, where it has one.
+        let mut per_pixel: Option<Vec<f32>> = None;
         let mut compute = || -> Result<()> {
             match metric {
                 DiffMetric::Flip => {
@@ -162,6 +259,7 @@ pub fn diff(
                     p.insert("weighted_p75".into(), pool::weighted_percentile(v, 0.75));
                     p.insert("max".into(), pool::max(v));
                     r.value = Some(s.mean);
+                    per_pixel = Some(v.clone());
                     r.percentiles = Some(p);
                     r.histogram = Some(pool::histogram(v, 20));
                     if let Some(path) = map_path(metric) {
@@ -180,9 +278,9 @@ pub fn diff(
                 DiffMetric::Ssim => {
                     let (mean, smap) = ssim::ssim(&a, &b, ssim::SsimInput::SrgbLuma)?;
                     r.value = Some(mean);
+                    let err: Vec<f32> = smap.iter().map(|s| (1.0 - s).clamp(0.0, 1.0)).collect();
+                    per_pixel = Some(err.clone());
                     if let Some(path) = map_path(metric) {
-                        let err: Vec<f32> =
-                            smap.iter().map(|s| (1.0 - s).clamp(0.0, 1.0)).collect();
                         crate::io::write_image(
                             &path,
                             &image::DynamicImage::ImageRgb8(colormap::heat_map(
@@ -204,6 +302,7 @@ pub fn diff(
                     let s = vdp.compare(&a, &b)?;
                     r.value = Some(s.probability);
                     r.jnd = Some(s.jnd);
+                    per_pixel = Some(s.map.values.clone());
                     if let Some(path) = map_path(metric) {
                         let img = colormap::heat_map(&s.map.values, w, h, (h / 32).max(4));
                         crate::io::write_image(&path, &image::DynamicImage::ImageRgb8(img))?;
@@ -216,6 +315,23 @@ pub fn diff(
         match compute() {
             Err(Error::Usage(why)) if lenient => r.note = Some(why),
             other => other?,
+        }
+        if let Some(values) = &per_pixel {
+            let mut worst: Option<(usize, f32)> = None;
+            for (i, &v) in values.iter().enumerate() {
+                if worst.is_none_or(|(_, w)| v > w) {
+                    worst = Some((i, v));
+                }
+            }
+            r.worst_pixel = worst.map(|(i, v)| WorstPixel {
+                x: i % w,
+                y: i / w,
+                value: v as f64,
+            });
+            if let Some(t) = pixel_threshold {
+                let over = values.iter().filter(|&&v| v as f64 > t).count();
+                r.share_over = Some(over as f64 / values.len().max(1) as f64);
+            }
         }
         out.push(r);
     }

@@ -50,8 +50,9 @@ pub(crate) struct DiffArgs {
     /// Where FLIP, MSE and PSNR run: cpu, gpu (compute kernels) or auto.
     #[arg(long, value_enum, default_value_t = BackendArg::Cpu)]
     pub(crate) backend: BackendArg,
-    /// Test image, same size.
-    pub(crate) test: PathBuf,
+    /// Test image(s), each the reference's size; each is compared with the reference.
+    #[arg(required = true, num_args = 1..)]
+    pub(crate) test: Vec<PathBuf>,
     /// Metric: flip, ssim, msssim, psnr, mse, vdp or all.
     #[arg(long, value_enum, default_value_t = MetricArg::Flip)]
     pub(crate) metric: MetricArg,
@@ -84,9 +85,56 @@ pub(crate) struct DiffArgs {
     /// probability).
     #[arg(long)]
     pub(crate) map: Option<PathBuf>,
-    /// Print JSON (an array, one object per metric).
+    /// Fail (exit 1) when the gated metric's pooled value is worse than this (above it for
+    /// flip, mse and vdp; below it for ssim, msssim and psnr). The gated metric is --metric's
+    /// (flip for `all`).
+    #[arg(long)]
+    pub(crate) fail: Option<f64>,
+    /// Warn (exit 0, a warning line) when the pooled value is worse than this.
+    #[arg(long)]
+    pub(crate) warn: Option<f64>,
+    /// Fail when more than this percentage of pixels exceed --fail-pixel on the gated metric's
+    /// map (FLIP error, 1 − SSIM, or the VDP's detection probability).
+    #[arg(long, requires = "fail_pixel")]
+    pub(crate) fail_percent: Option<f64>,
+    /// Warn when more than this percentage of pixels exceed --fail-pixel.
+    #[arg(long, requires = "fail_pixel")]
+    pub(crate) warn_percent: Option<f64>,
+    /// The per-pixel threshold of --fail-percent and --warn-percent, in the map's units (0–1).
+    #[arg(long)]
+    pub(crate) fail_pixel: Option<f64>,
+    /// Also write every result as CSV here (reference, test, metric, value, the worst pixel, the
+    /// share over --fail-pixel, the verdict).
+    #[arg(long)]
+    pub(crate) csv: Option<PathBuf>,
+    /// Print JSON (an array, one object per metric; with several test images, one object per
+    /// image with its results and verdict).
     #[arg(long)]
     pub(crate) json: bool,
+}
+
+/// One row of `--csv`.
+#[derive(serde::Serialize)]
+struct CsvRow<'a> {
+    reference: String,
+    test: String,
+    metric: &'a str,
+    value: Option<f64>,
+    jnd: Option<f64>,
+    worst_x: Option<usize>,
+    worst_y: Option<usize>,
+    worst_value: Option<f64>,
+    share_over: Option<f64>,
+    verdict: &'a str,
+}
+
+/// One test image's results and verdict, for JSON with several images.
+#[derive(serde::Serialize)]
+struct PerTest<'a> {
+    test: &'a std::path::Path,
+    results: &'a [lodeval::app::DiffResult],
+    verdict: &'a str,
+    reasons: Vec<String>,
 }
 
 /// Run `diff`.
@@ -115,44 +163,166 @@ pub(crate) fn run(a: DiffArgs) -> Result<(), Error> {
         a.ambient_lux,
         a.reflectivity,
     )?;
-    let results = lodeval::app::diff(
-        &engine,
-        &a.reference,
-        &a.test,
-        &metrics,
-        &lodeval::app::Seen { viewing, display },
-        a.map.as_deref(),
-        lenient,
-    )?;
+    let gates = lodeval::app::DiffGates {
+        fail: a.fail,
+        warn: a.warn,
+        fail_percent: a.fail_percent,
+        warn_percent: a.warn_percent,
+        pixel: a.fail_pixel,
+    };
+    for (flag, v) in [
+        ("--fail", a.fail),
+        ("--warn", a.warn),
+        ("--fail-percent", a.fail_percent),
+        ("--warn-percent", a.warn_percent),
+        ("--fail-pixel", a.fail_pixel),
+    ] {
+        if v.is_some_and(|v| !v.is_finite()) {
+            return Err(Error::Usage(format!("{flag}: give a finite number")));
+        }
+    }
+    let gated = metrics[0];
+    if (a.fail_percent.is_some() || a.warn_percent.is_some())
+        && !matches!(gated, DiffMetric::Flip | DiffMetric::Ssim | DiffMetric::Vdp)
+    {
+        return Err(Error::Usage(format!(
+            "--fail-percent and --warn-percent need a per-pixel map: use --metric flip, ssim or \
+             vdp, not {}",
+            gated.name()
+        )));
+    }
+    let seen = lodeval::app::Seen { viewing, display };
+    let several = a.test.len() > 1;
+    let mut all = Vec::new();
+    for test in &a.test {
+        // With several test images, each one's heat map is named after it.
+        let map = a.map.as_ref().map(|m| {
+            if several {
+                let stem = test.file_stem().unwrap_or_default().to_string_lossy();
+                let base = m.file_stem().unwrap_or_default().to_string_lossy();
+                m.with_file_name(format!("{base}-{stem}.png"))
+            } else {
+                m.clone()
+            }
+        });
+        let results = lodeval::app::diff(
+            &engine,
+            &a.reference,
+            test,
+            &metrics,
+            &seen,
+            map.as_deref(),
+            lenient,
+            a.fail_pixel,
+        )?;
+        let gate_row = results.iter().find(|r| r.metric == gated);
+        let (fail, warn) = gate_row.map_or((None, None), |r| lodeval::app::judge(r, &gates));
+        all.push((test.clone(), results, fail, warn));
+    }
+    let verdict = |fail: &Option<String>, warn: &Option<String>| {
+        if fail.is_some() {
+            "fail"
+        } else if warn.is_some() {
+            "warn"
+        } else {
+            "pass"
+        }
+    };
+    if let Some(path) = &a.csv {
+        let mut rows = Vec::new();
+        for (test, results, fail, warn) in &all {
+            for r in results {
+                rows.push(CsvRow {
+                    reference: a.reference.display().to_string(),
+                    test: test.display().to_string(),
+                    metric: r.metric.name(),
+                    value: r.value,
+                    jnd: r.jnd,
+                    worst_x: r.worst_pixel.map(|w| w.x),
+                    worst_y: r.worst_pixel.map(|w| w.y),
+                    worst_value: r.worst_pixel.map(|w| w.value),
+                    share_over: r.share_over,
+                    verdict: if r.metric == gated {
+                        verdict(fail, warn)
+                    } else {
+                        ""
+                    },
+                });
+            }
+        }
+        lodeval::io::csv::write_rows(path, None, &rows)?;
+    }
     if a.json {
-        emit_json(&results)
+        if several {
+            let per: Vec<PerTest> = all
+                .iter()
+                .map(|(test, results, fail, warn)| PerTest {
+                    test,
+                    results,
+                    verdict: verdict(fail, warn),
+                    reasons: fail.iter().chain(warn).cloned().collect(),
+                })
+                .collect();
+            emit_json(&per)?;
+        } else {
+            emit_json(&all[0].1)?;
+        }
     } else {
         let mut text = String::new();
-        for r in &results {
-            let name = serde_json::to_value(r.metric)
-                .ok()
-                .and_then(|v| v.as_str().map(str::to_string))
-                .unwrap_or_default();
-            let value = match (r.value, &r.note) {
-                (Some(v), _) => format!("{v:.6}"),
-                (None, Some(note)) => format!("-  ({note})"),
-                (None, None) => "inf".to_string(),
-            };
-            text.push_str(&format!("{name:<7} {value}"));
-            if let Some(p) = &r.percentiles {
-                text.push_str(&format!(
-                    "  (p95 {:.4}, max {:.4}, {:.2} ppd)",
-                    p["p95"], p["max"], r.ppd
-                ));
+        for (test, results, _, _) in &all {
+            if several {
+                text.push_str(&format!("{}:\n", test.display()));
             }
-            if let Some(j) = r.jnd {
-                text.push_str(&format!("  ({j:.3} JND, {:.2} ppd)", r.ppd));
+            for r in results {
+                text.push_str(&line(r));
             }
-            if let Some(m) = &r.map {
-                text.push_str(&format!("  map: {}", m.display()));
-            }
-            text.push('\n');
         }
-        emit(&text)
+        emit(&text)?;
     }
+    let mut failed = Vec::new();
+    for (test, _, fail, warn) in &all {
+        if let Some(w) = warn
+            && fail.is_none()
+        {
+            note!("warning: {}: {w}", test.display());
+        }
+        if let Some(f) = fail {
+            failed.push(format!("{}: {f}", test.display()));
+        }
+    }
+    if failed.is_empty() {
+        Ok(())
+    } else {
+        Err(Error::Regression(failed.join("; ")))
+    }
+}
+
+/// One metric's line of text.
+fn line(r: &lodeval::app::DiffResult) -> String {
+    let value = match (r.value, &r.note) {
+        (Some(v), _) => format!("{v:.6}"),
+        (None, Some(note)) => format!("-  ({note})"),
+        (None, None) => "inf".to_string(),
+    };
+    let mut text = format!("{:<7} {value}", r.metric.name());
+    if let Some(p) = &r.percentiles {
+        text.push_str(&format!(
+            "  (p95 {:.4}, max {:.4}, {:.2} ppd)",
+            p["p95"], p["max"], r.ppd
+        ));
+    }
+    if let Some(j) = r.jnd {
+        text.push_str(&format!("  ({j:.3} JND, {:.2} ppd)", r.ppd));
+    }
+    if let Some(w) = r.worst_pixel {
+        text.push_str(&format!("  worst pixel ({}, {}): {:.4}", w.x, w.y, w.value));
+    }
+    if let Some(s) = r.share_over {
+        text.push_str(&format!("  {:.3} % over the pixel limit", 100.0 * s));
+    }
+    if let Some(m) = &r.map {
+        text.push_str(&format!("  map: {}", m.display()));
+    }
+    text.push('\n');
+    text
 }

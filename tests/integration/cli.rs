@@ -290,3 +290,93 @@ fn compare_scores_what_eval_scores_for_the_same_views() {
     let r = lodeval(["compare", original.to_str().unwrap(), "/nonexistent/x.obj"]);
     assert_eq!(r.code, 2, "{}", r.stderr);
 }
+
+#[test]
+fn diff_gates_grade_exit_codes_and_report_the_worst_pixel() {
+    let dir = tempfile::tempdir().unwrap();
+    let o = |f: &str| crate::common::root().join("reference/oracles/flip").join(f);
+    let (r, t) = (o("lines_70_ref.png"), o("lines_70_test.png"));
+    let (r, t) = (r.to_str().unwrap(), t.to_str().unwrap());
+    let run = |extra: &[&str]| {
+        let mut args = vec!["diff", r, t, "--ppd", "40"];
+        args.extend_from_slice(extra);
+        lodeval(args)
+    };
+    // The pair's mean FLIP is about 0.1: a loose limit passes, a tight one fails with exit 1.
+    let pass = run(&["--fail", "0.9"]);
+    assert_eq!(pass.code, 0, "{}", pass.stderr);
+    assert!(pass.stdout.contains("worst pixel ("), "{}", pass.stdout);
+    let fail = run(&["--fail", "0.001"]);
+    assert_eq!(fail.code, 1, "{}", fail.stderr);
+    assert!(
+        fail.stderr.contains("above the fail limit 0.001"),
+        "{}",
+        fail.stderr
+    );
+    // A warning is exit 0 with a line.
+    let warn = run(&["--warn", "0.001"]);
+    assert_eq!(warn.code, 0, "{}", warn.stderr);
+    assert!(
+        warn.stderr.contains("warning:") && warn.stderr.contains("warn limit"),
+        "{}",
+        warn.stderr
+    );
+    // The share of pixels over a per-pixel threshold.
+    let share = run(&["--fail-percent", "0.5", "--fail-pixel", "0.05", "--json"]);
+    assert_eq!(share.code, 1, "{}", share.stderr);
+    let v: serde_json::Value = serde_json::from_str(&share.stdout).unwrap();
+    let s = v[0]["share_over"].as_f64().unwrap();
+    assert!(s > 0.005 && s <= 1.0, "{s}");
+    let w = &v[0]["worst_pixel"];
+    assert!(
+        w["x"].as_u64().unwrap() < 70 && w["y"].as_u64().unwrap() < 70,
+        "{w}"
+    );
+    assert!(
+        (w["value"].as_f64().unwrap() - v[0]["percentiles"]["max"].as_f64().unwrap()).abs() < 1e-6
+    );
+    // PSNR gates the other way: below the limit fails.
+    assert_eq!(run(&["--metric", "psnr", "--fail", "200"]).code, 1);
+    assert_eq!(run(&["--metric", "psnr", "--fail", "1"]).code, 0);
+    // Percentage gates need a metric with a per-pixel map.
+    let bad = run(&[
+        "--metric",
+        "psnr",
+        "--fail-percent",
+        "1",
+        "--fail-pixel",
+        "0.1",
+    ]);
+    assert_eq!(bad.code, 2, "{}", bad.stderr);
+    // Several test images in one call, with CSV: the identical one passes, the other fails.
+    let csv = dir.path().join("d.csv");
+    let many = lodeval([
+        "diff",
+        r,
+        r,
+        t,
+        "--ppd",
+        "40",
+        "--fail",
+        "0.01",
+        "--csv",
+        csv.to_str().unwrap(),
+        "--json",
+    ]);
+    assert_eq!(many.code, 1, "{}", many.stderr);
+    let v: serde_json::Value = serde_json::from_str(&many.stdout).unwrap();
+    assert_eq!(v.as_array().unwrap().len(), 2);
+    assert_eq!(
+        (v[0]["verdict"].as_str(), v[1]["verdict"].as_str()),
+        (Some("pass"), Some("fail"))
+    );
+    let table = std::fs::read_to_string(&csv).unwrap();
+    assert!(
+        table.starts_with(
+            "reference,test,metric,value,jnd,worst_x,worst_y,worst_value,share_over,verdict"
+        ),
+        "{table}"
+    );
+    assert_eq!(table.lines().count(), 3, "{table}");
+    assert!(table.lines().nth(2).unwrap().ends_with(",fail"), "{table}");
+}
