@@ -28,6 +28,9 @@ pub(crate) enum BenchTarget {
 }
 
 #[derive(Args, Debug)]
+#[command(
+    after_help = "Example:\n  lodeval bench raster\n  lodeval bench menzel-guthe reference/models/bunny/stanford-bunny.obj\n\nExit codes: 0 measured · 2 bad input or usage · 3 internal error"
+)]
 pub(crate) struct BenchArgs {
     /// What to measure: `raster`, `metrics REF TEST`, `simplify MESH...`, `williams MESH...` or
     /// `optimize MESH...` (the image-driven optimizer's evaluations per second, 20 views at 256²,

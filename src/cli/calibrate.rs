@@ -15,6 +15,9 @@ pub(crate) enum CalibrationSet {
 }
 
 #[derive(Args, Debug)]
+#[command(
+    after_help = "Example:\n  lodeval calibrate modelfest\n\nExit codes: 0 calibrated and reported · 2 a missing or damaged oracle, or bad conditions · 3 internal error"
+)]
 pub(crate) struct CalibrateArgs {
     /// The dataset.
     #[arg(value_enum)]

@@ -44,6 +44,9 @@ impl MetricArg {
 }
 
 #[derive(Args, Debug)]
+#[command(
+    after_help = "Example:\n  lodeval diff expected.png actual.png --metric flip --fail 0.05\n  lodeval diff ref.png a.png b.png --fail-percent 0.5 --fail-pixel 0.1 --csv diff.csv\n\nExit codes: 0 pass (or warn, with a warning line) · 1 a --fail gate failed · 2 bad input or usage · 3 internal error"
+)]
 pub(crate) struct DiffArgs {
     /// Reference image (PNG/JPEG: sRGB; EXR: linear).
     pub(crate) reference: PathBuf,

@@ -10,6 +10,9 @@ use super::print::gate_result;
 use super::progress::Reporter;
 
 #[derive(Args, Debug)]
+#[command(
+    after_help = "Example:\n  lodeval eval configs/demo.toml\n  lodeval eval configs/ci.toml --shard 0/2 --out results/ci-0\n\nExit codes: 0 every gate passed · 1 a gate failed (details in report.html) · 2 bad config or input · 3 internal error"
+)]
 pub(crate) struct EvalArgs {
     /// The batch config (TOML; see configs/README.md).
     pub(crate) config: PathBuf,

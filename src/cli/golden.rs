@@ -8,6 +8,9 @@ use lodeval::Error;
 use super::print::emit;
 
 #[derive(Args, Debug)]
+#[command(
+    after_help = "Example:\n  lodeval golden configs/ci.toml\n  lodeval golden configs/ci.toml --bless\n\nExit codes: 0 every image matches (or blessed) · 1 a golden image mismatched · 2 bad config or input · 3 internal error"
+)]
 pub(crate) struct GoldenArgs {
     /// The batch config whose renders are checked.
     pub(crate) config: PathBuf,

@@ -9,6 +9,9 @@ use super::args::LoadArgs;
 use super::print::{emit, emit_json};
 
 #[derive(Args, Debug)]
+#[command(
+    after_help = "Example:\n  lodeval info reference/models/spot/spot_mtl.obj --json\n\nExit codes: 0 read · 2 the file is bad (the message names the line or element) · 3 internal error"
+)]
 pub(crate) struct InfoArgs {
     /// The mesh file (.obj, .ply, .gltf, .glb, .off).
     pub(crate) mesh: PathBuf,

@@ -17,6 +17,7 @@ mod bench;
 mod calibrate;
 mod compare;
 mod diff;
+mod docs;
 mod eval;
 mod geometry;
 mod golden;
@@ -37,7 +38,10 @@ use lodeval::Error;
 #[command(
     name = "lodeval",
     version,
-    about = "Does a simplified mesh still look like the original, and from how far away can nobody tell them apart?"
+    about = "Does a simplified mesh still look like the original, and from how far away can nobody tell them apart?",
+    after_help = "Exit codes: 0 success · 1 the gate found a regression, a golden image mismatched \
+        or diff --fail failed · 2 bad input or usage (one message naming the file and what to do) · \
+        3 internal error (a lodeval bug)\n\nStart with: lodeval eval configs/demo.toml"
 )]
 pub(crate) struct Cli {
     /// Worker threads, 1 to 1024 (default: all cores). Results are identical for any value.
@@ -83,6 +87,10 @@ enum Command {
     Merge(merge::MergeArgs),
     /// Check the visible-difference predictor against observers' detection thresholds.
     Calibrate(calibrate::CalibrateArgs),
+    /// Print a shell completion script (bash, zsh, fish, elvish, powershell).
+    Completions(docs::CompletionsArgs),
+    /// Print the manual page, or write one per command into a folder.
+    Man(docs::ManArgs),
 }
 
 /// Set up the worker threads and run the command.
@@ -108,5 +116,7 @@ pub(crate) fn run(cli: Cli) -> Result<(), Error> {
         Command::Bench(a) => bench::run(a),
         Command::Merge(a) => merge::run(a),
         Command::Calibrate(a) => calibrate::run(a),
+        Command::Completions(a) => docs::completions(a),
+        Command::Man(a) => docs::man(a),
     }
 }

@@ -20,6 +20,9 @@ pub(crate) enum NormalsArg {
 }
 
 #[derive(Args, Debug)]
+#[command(
+    after_help = "Example:\n  lodeval optimize bunny.obj bunny-lod.obj -o bunny-opt.obj --evals 20000\n\nExit codes: 0 written · 2 bad input or usage · 3 internal error"
+)]
 pub(crate) struct OptimizeArgs {
     /// The original mesh (the target of the renderings).
     #[arg(required_unless_present = "experiment")]

@@ -15,6 +15,9 @@ use super::args::{
 use super::print::warnings;
 
 #[derive(Args, Debug)]
+#[command(
+    after_help = "Example:\n  lodeval render reference/models/spot/spot_mtl.obj -o spot.png --view 3\n  lodeval render spot.obj --sheet -o sheet.png --size 256\n\nExit codes: 0 written · 2 bad input or usage · 3 internal error"
+)]
 pub(crate) struct RenderArgs {
     /// The mesh file.
     pub(crate) mesh: PathBuf,

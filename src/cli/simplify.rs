@@ -75,6 +75,9 @@ impl CriterionArg {
 }
 
 #[derive(Args, Debug)]
+#[command(
+    after_help = "Example:\n  lodeval simplify reference/models/bunny/stanford-bunny.obj -o bunny.obj --ratio 0.25\n  lodeval simplify spot.obj -o spot.obj --method menzel-guthe --distance 5\n\nExit codes: 0 written · 2 bad input or usage · 3 internal error"
+)]
 pub(crate) struct SimplifyArgs {
     /// The mesh to simplify.
     #[arg(required_unless_present = "experiment")]

@@ -380,3 +380,60 @@ fn diff_gates_grade_exit_codes_and_report_the_worst_pixel() {
     assert_eq!(table.lines().count(), 3, "{table}");
     assert!(table.lines().nth(2).unwrap().ends_with(",fail"), "{table}");
 }
+
+#[test]
+fn completions_man_pages_and_help_with_examples_and_exit_codes() {
+    let dir = tempfile::tempdir().unwrap();
+    for shell in ["bash", "zsh", "fish"] {
+        let r = lodeval(["completions", shell]);
+        assert_eq!(r.code, 0, "{}", r.stderr);
+        assert!(
+            r.stdout.contains("remesh") && r.stdout.contains("compare"),
+            "{shell}"
+        );
+    }
+    let r = lodeval(["man"]);
+    assert_eq!(r.code, 0, "{}", r.stderr);
+    assert!(
+        r.stdout.starts_with(".ie") && r.stdout.contains(".TH lodeval 1"),
+        "{}",
+        &r.stdout[..200]
+    );
+    let r = lodeval(["man", "--out-dir", dir.path().to_str().unwrap()]);
+    assert_eq!(r.code, 0, "{}", r.stderr);
+    for page in [
+        "lodeval.1",
+        "lodeval-eval.1",
+        "lodeval-diff.1",
+        "lodeval-remesh.1",
+    ] {
+        let text = std::fs::read_to_string(dir.path().join(page)).unwrap();
+        assert!(text.contains(".TH"), "{page}");
+    }
+    // Every command's --help has an example and its exit codes.
+    for cmd in [
+        "eval",
+        "golden",
+        "simplify",
+        "optimize",
+        "render",
+        "diff",
+        "compare",
+        "info",
+        "geometry",
+        "bench",
+        "merge",
+        "calibrate",
+        "remesh",
+        "completions",
+        "man",
+    ] {
+        let r = lodeval([cmd, "--help"]);
+        assert_eq!(r.code, 0, "{cmd}: {}", r.stderr);
+        assert!(
+            r.stdout.contains("Example:") && r.stdout.contains("Exit codes: 0"),
+            "{cmd}: {}",
+            r.stdout
+        );
+    }
+}
