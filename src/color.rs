@@ -1,5 +1,5 @@
 //! Colour encodings and colour spaces. Rendering and metrics work in linear RGB `f32`; sRGB appears only when
-//! reading or writing 8-bit images (README, Architecture, "Colour").
+//! reading or writing 8-bit images (ARCHITECTURE.md, "Colour").
 //!
 //! Based on: IEC 61966-2-1:1999 (sRGB transfer function, piecewise with the linear toe; the
 //! linear-sRGB ↔ XYZ matrices for D65); CIE 15 (CIELAB); Xuemei Zhang, Brian Wandell. A Spatial
@@ -172,7 +172,7 @@ pub fn linear_to_srgb_fast(c: f32) -> f32 {
     table[i] + (table[i + 1] - table[i]) * t
 }
 
-/// Rec. 709 luminance of linear RGB (README, Architecture, "Colour": the luminance lodeval uses unless a metric's
+/// Rec. 709 luminance of linear RGB (ARCHITECTURE.md, "Colour": the luminance lodeval uses unless a metric's
 /// definition says otherwise).
 pub fn luminance(c: Vec3) -> f32 {
     0.2126 * c.x + 0.7152 * c.y + 0.0722 * c.z

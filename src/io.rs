@@ -1,8 +1,8 @@
 //! Files in and out. Inputs are read only from regular files and only up to a size the format
 //! can need ([`read_input`], [`check_input`]), so a FIFO, `/dev/zero` or a symlink to one is an
 //! error, not a hang. Outputs are written to a temporary file in the destination folder and
-//! renamed into place, so a crash or a bad input never leaves a half-written output (README,
-//! Architecture, "Errors"). The 8-bit image writers here are the only place where linear colour
+//! renamed into place, so a crash or a bad input never leaves a half-written output (ARCHITECTURE.md,
+//! "Errors"). The 8-bit image writers here are the only place where linear colour
 //! becomes sRGB bytes on disk.
 
 pub mod csv;

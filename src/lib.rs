@@ -1,8 +1,8 @@
 //! lodeval: does a simplified mesh (a level of detail) still look like the original, and from how
 //! far away can nobody tell them apart?
 //!
-//! The crate is built in layers, each using only the layers below it (the README's Architecture
-//! section has the table; `src/layers.rs` tests it):
+//! The crate is built in layers, each using only the layers below it (ARCHITECTURE.md has
+//! the whole picture; `src/layers.rs` tests it):
 //!
 //! ```text
 //! error · color · image · io      shared ground: errors, colour encodings, linear images, files

@@ -5,7 +5,7 @@
 //! fills in missing normals (`normals.rs`), welds positions (`weld.rs`) and computes bounds
 //! (`bounds.rs`). A [`Mesh`] therefore always holds a valid mesh; see its `# Guarantees`.
 //!
-//! Decisions taken where the architecture contract (README, "Architecture") is silent:
+//! Decisions taken where the architecture contract (ARCHITECTURE.md) is silent:
 //! - Vertices are split wherever the file gives different UVs, normals or colours at one position
 //!   ("seams"); [`Mesh::weld`] maps every vertex back to its welded position. Welding is by exact
 //!   coordinate equality (−0 and +0 are equal), the same rule meshoptimizer's position remap uses, so

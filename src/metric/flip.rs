@@ -14,7 +14,7 @@
 //! clamped, the spatial filter radius is ⌈3·√(max b / 2π²)·ppd⌉, the feature filter's Gaussian sums
 //! to 1 and the positive and negative lobes of its derivatives to ±1, arithmetic is `f32`.
 //!
-//! Prepare once, compare many (README, Architecture): [`Flip::prepare`] does each image's filtering; the
+//! Prepare once, compare many (ARCHITECTURE.md): [`Flip::prepare`] does each image's filtering; the
 //! comparison is per pixel. Rows run in parallel; every pixel's arithmetic is independent of the
 //! schedule, and the mean is a fixed-order sum of per-row `f64` sums, so results do not depend on
 //! the thread count.

@@ -4,7 +4,7 @@
 //! d_MS(Y⁰, Y¹) = 1/(l·m·n) Σ_h Σ_i Σ_j (y⁰_hij − y¹_hij)², the mean squared luminance difference
 //! over l views of m × n pixels.
 //!
-//! Decision: "luminance" is Rec. 709 Y of linear RGB (README, Architecture, "Colour"), so MSE is in linear
+//! Decision: "luminance" is Rec. 709 Y of linear RGB (ARCHITECTURE.md, "Colour"), so MSE is in linear
 //! luminance units and PSNR uses a peak of 1 (display white).
 //!
 //! Decision: PSNR saturates at [`PSNR_CEILING_DB`] = 100 dB (an RMS difference of 1e-5 of white,

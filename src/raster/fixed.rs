@@ -3,7 +3,7 @@
 //! Screen positions are snapped to 1/256 pixel ([`Fx24_8`]: 24 integer bits, 8 fraction bits) so
 //! that edge functions are evaluated exactly in integers: every sample is classified identically
 //! for the two triangles sharing an edge, which is what makes the top-left rule watertight and the
-//! output independent of evaluation order (README, Architecture, "Determinism").
+//! output independent of evaluation order (ARCHITECTURE.md, "Determinism").
 //!
 //! Range: clipping keeps vertices within [`GUARD_BAND_PX`] of the viewport, so coordinates stay
 //! below 2^15·2^8 = 2^23 in magnitude and an edge function (a difference of two products of such

@@ -2,7 +2,7 @@
 //!
 //! Decision: pixels per degree follow FLIP's reference implementation (and its paper's
 //! definition), the small-angle form ppd = d · (N_px / W) · π/180 for a display W metres wide with
-//! N_px pixels seen from d metres. The default (README, Architecture, "Defaults") — a 0.7 m wide, 3840-pixel display at
+//! N_px pixels seen from d metres. The default (ARCHITECTURE.md, "Defaults") — a 0.7 m wide, 3840-pixel display at
 //! 0.7 m — gives 67.02 ppd.
 
 /// A display and the viewer's distance to it.
