@@ -159,6 +159,17 @@ pub fn judge(r: &DiffResult, gates: &DiffGates) -> (Option<String>, Option<Strin
     (fail, warn)
 }
 
+/// What `diff` writes and how it treats metrics that do not apply.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct DiffOptions<'a> {
+    /// Heat map path (see [`diff`]).
+    pub map: Option<&'a Path>,
+    /// Report a metric that does not apply to the image size with a note instead of failing.
+    pub lenient: bool,
+    /// A per-pixel threshold: each per-pixel map also gives the share of pixels above it.
+    pub pixel_threshold: Option<f64>,
+}
+
 /// Where and on what the compared images are seen.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Seen {
@@ -168,21 +179,24 @@ pub struct Seen {
     pub display: crate::metric::vdp::Display,
 }
 
-/// Compare two image files with the given metrics; writes magma heat maps if `map` is given
-/// (`map` itself for one metric with a map, `STEM-METRIC.png` beside it for several). With
-/// `lenient`, a metric that does not apply to images of this size (SSIM below 11×11, MS-SSIM
+/// Compare two image files with the given metrics; writes magma heat maps if `options.map` is
+/// given (that path for one metric with a map, `STEM-METRIC.png` beside it for several). With
+/// `options.lenient`, a metric that does not apply to images of this size (SSIM below 11×11, MS-SSIM
 /// below 176×176) is reported without a value and with a note instead of failing the command.
-/// With `pixel_threshold`, each per-pixel map also gives the share of pixels above it.
+/// With `options.pixel_threshold`, each per-pixel map also gives the share of pixels above it.
 pub fn diff(
     engine: &crate::backend::Engine,
     reference: &Path,
     test: &Path,
     metrics: &[DiffMetric],
     seen: &Seen,
-    map: Option<&Path>,
-    lenient: bool,
-    pixel_threshold: Option<f64>,
+    options: &DiffOptions<'_>,
 ) -> Result<Vec<DiffResult>> {
+    let DiffOptions {
+        map,
+        lenient,
+        pixel_threshold,
+    } = *options;
     use crate::metric::{LinearImage, colormap, flip::Flip, pool, ssim};
     let (a, b) = (LinearImage::load(reference)?, LinearImage::load(test)?);
     if (a.width(), a.height()) != (b.width(), b.height()) {

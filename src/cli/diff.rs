@@ -214,9 +214,11 @@ pub(crate) fn run(a: DiffArgs) -> Result<(), Error> {
             test,
             &metrics,
             &seen,
-            map.as_deref(),
-            lenient,
-            a.fail_pixel,
+            &lodeval::app::DiffOptions {
+                map: map.as_deref(),
+                lenient,
+                pixel_threshold: a.fail_pixel,
+            },
         )?;
         let gate_row = results.iter().find(|r| r.metric == gated);
         let (fail, warn) = gate_row.map_or((None, None), |r| lodeval::app::judge(r, &gates));
