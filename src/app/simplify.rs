@@ -64,11 +64,20 @@ pub struct SimplifyReport {
     pub warnings: Vec<String>,
 }
 
-/// Check that `out` is an OBJ path, then load `input` (the simplifiers' common start).
+/// Whether `out` asks for one glTF LOD chain (`.glb`, `.gltf`) rather than OBJ files.
+fn gltf_out(out: &Path) -> bool {
+    matches!(
+        out.extension().and_then(|e| e.to_str()),
+        Some("glb" | "gltf")
+    )
+}
+
+/// Check that `out` is an OBJ or glTF path, then load `input` (the simplifiers' common start).
 fn load_for_lod(input: &Path, out: &Path) -> Result<Mesh> {
-    if out.extension().and_then(|e| e.to_str()) != Some("obj") {
+    if out.extension().and_then(|e| e.to_str()) != Some("obj") && !gltf_out(out) {
         return Err(Error::Usage(format!(
-            "-o {}: lodeval writes LODs as .obj (with .mtl and textures beside it)",
+            "-o {}: lodeval writes LODs as .obj (with .mtl and textures beside it), or a whole \
+             chain as one .glb or .gltf",
             out.display()
         )));
     }
@@ -82,11 +91,26 @@ pub fn simplify(
 ) -> Result<SimplifyReport> {
     let mesh = load_for_lod(&job.mesh, &job.out)?;
     // Every file of the chain is checked before the simplifier runs: none may be an input.
-    let files: Vec<PathBuf> = job.goals.iter().map(|g| lod_file(job, g)).collect();
-    let planned: Vec<PathBuf> = files
+    let gltf = gltf_out(&job.out);
+    let files: Vec<PathBuf> = job
+        .goals
         .iter()
-        .flat_map(|f| crate::mesh::write_obj::planned_files(&mesh, f))
+        .map(|g| {
+            if gltf {
+                job.out.clone()
+            } else {
+                lod_file(job, g)
+            }
+        })
         .collect();
+    let planned: Vec<PathBuf> = if gltf {
+        vec![job.out.clone(), job.out.with_extension("bin")]
+    } else {
+        files
+            .iter()
+            .flat_map(|f| crate::mesh::write_obj::planned_files(&mesh, f))
+            .collect()
+    };
     crate::io::check_not_inputs(&planned, &mesh.source().files)?;
     let start = std::time::Instant::now();
     progress.start(
@@ -134,9 +158,32 @@ pub fn simplify(
     progress.finish();
     let lods = lods?;
     let seconds = start.elapsed().as_secs_f64();
+    if gltf {
+        // One asset: the original and every LOD, switching where each was measured invisible.
+        let original = std::sync::Arc::new(mesh.clone());
+        let named: Vec<(String, std::sync::Arc<Mesh>)> = lods
+            .iter()
+            .zip(&job.goals)
+            .map(|((l, _, _), g)| (goal_name(job.method, g), std::sync::Arc::new(l.clone())))
+            .collect();
+        let refs: Vec<(&str, std::sync::Arc<Mesh>)> =
+            named.iter().map(|(n, m)| (n.as_str(), m.clone())).collect();
+        let rows = crate::eval::export::measure(&original, &refs, job.meters_per_unit)?;
+        let chain: Vec<(&str, &Mesh)> = named.iter().map(|(n, m)| (n.as_str(), &**m)).collect();
+        let (_, notes) = crate::eval::export::write_chain(
+            &job.out,
+            crate::eval::export::ORIGINAL,
+            &mesh,
+            &chain,
+            &rows,
+        )?;
+        warnings.extend(notes);
+    }
     let mut rows = Vec::new();
     for ((lod, error, mg), file) in lods.iter().zip(files) {
-        crate::mesh::write_obj::write(lod, &file)?;
+        if !gltf {
+            crate::mesh::write_obj::write(lod, &file)?;
+        }
         rows.push(SimplifyRow {
             file,
             triangles: lod.triangle_count(),
@@ -147,6 +194,23 @@ pub fn simplify(
         });
     }
     Ok(SimplifyReport { rows, warnings })
+}
+
+/// A LOD's name in a glTF chain: the method and the goal (`qem-r50`, `meshopt-t1000`).
+fn goal_name(method: crate::simplify::Method, goal: &crate::simplify::Goal) -> String {
+    let stem = PathBuf::from(format!("{}.obj", method.name()));
+    let probe = SimplifyJob {
+        mesh: PathBuf::new(),
+        out: stem,
+        method,
+        goals: Vec::new(),
+        chain: true,
+        meters_per_unit: 1.0,
+    };
+    lod_file(&probe, goal).file_stem().map_or_else(
+        || method.name().to_string(),
+        |s| s.to_string_lossy().into_owned(),
+    )
 }
 
 /// The file a LOD of `goal` goes to: `out` itself, or in a chain `STEM-r50.obj`, `STEM-t1000.obj`,

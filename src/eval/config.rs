@@ -57,6 +57,9 @@ pub struct Config {
     /// Golden-image comparison (`lodeval golden`).
     #[serde(default)]
     pub golden: GoldenConfig,
+    /// LOD chains for engines.
+    #[serde(default)]
+    pub export: ExportConfig,
     /// The assets.
     #[serde(rename = "asset")]
     pub assets: Vec<AssetConfig>,
@@ -261,6 +264,29 @@ impl Default for ImagesConfig {
             sheet_views: 6,
         }
     }
+}
+
+/// `[export]`: LOD chains for engines.
+#[derive(Debug, Clone, Default, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields, default)]
+pub struct ExportConfig {
+    /// Each asset's original and LODs as one glTF asset in `export/` (`ASSET.glb` or
+    /// `ASSET.gltf`), linked by `MSFT_lod` with switch points from the measured distances
+    /// (needs `[distance] enabled`). Default value: `none`.
+    pub gltf: GltfExport,
+}
+
+/// See [`ExportConfig::gltf`].
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum GltfExport {
+    /// No export.
+    #[default]
+    None,
+    /// One binary `.glb` per asset.
+    Glb,
+    /// `.gltf` JSON with its `.bin` and PNG images beside it.
+    Gltf,
 }
 
 /// See [`ImagesConfig::heatmaps`].

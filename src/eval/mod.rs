@@ -22,6 +22,7 @@
 pub mod compare;
 pub mod config;
 pub mod distance;
+pub mod export;
 pub mod gate;
 pub mod golden;
 pub mod junit;

@@ -29,6 +29,7 @@ pub const EVAL: &[&str] = &[
     "heatmaps",
     "sheets",
     "plots",
+    "export",
 ];
 
 /// What `golden` writes there (actual and diff images of mismatches).

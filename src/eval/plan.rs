@@ -278,6 +278,15 @@ impl Plan {
                 }
             }
         }
+        if self.config.export.gltf != super::config::GltfExport::None
+            && !self.config.distance.enabled
+        {
+            return Err(Error::input(
+                &self.config_path,
+                "[export] gltf takes its switch points from the measured distances, and                  [distance] is disabled",
+                "set [distance] enabled = true, or remove [export]",
+            ));
+        }
         Ok(())
     }
 

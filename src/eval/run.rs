@@ -20,7 +20,7 @@ use std::sync::Arc;
 
 use rayon::prelude::*;
 
-use super::config::{HeatmapChoice, MetricFamily};
+use super::config::{GltfExport, HeatmapChoice, MetricFamily};
 use super::distance::{self, DistanceJob};
 use super::plan::{AssetPlan, GenTarget, LodSource, Plan, Shard, case_id};
 use super::score::Scorer;
@@ -117,6 +117,7 @@ pub fn evaluate(
     let steps = cases * (views + usize::from(cfg.distance.enabled));
     progress.start(Some(steps as u64), "renders", "");
     let bar = progress;
+    let mut export_warnings = Vec::new();
     for asset in &plan.assets {
         let wanted: Vec<bool> = asset
             .lods
@@ -274,14 +275,36 @@ pub fn evaluate(
                 bar.advance(1);
             }
         }
+        let ext = match cfg.export.gltf {
+            GltfExport::None => None,
+            GltfExport::Glb => Some("glb"),
+            GltfExport::Gltf => Some("gltf"),
+        };
+        // A chain for engines: only from a run that has every LOD of the asset (not a shard's
+        // part of it).
+        if let (Some(out_dir), Some(ext)) = (images, ext)
+            && wanted.iter().all(|w| *w)
+        {
+            let chain: Vec<(&str, &Mesh)> = lods
+                .iter()
+                .map(|l| (l.name.as_str(), l.scene.scene().mesh()))
+                .collect();
+            let (_, notes) = super::export::write_chain(
+                &out_dir.join("export").join(format!("{}.{ext}", asset.name)),
+                &asset.name,
+                &original,
+                &chain,
+                &results.distances,
+            )?;
+            export_warnings.extend(notes);
+        }
         results.lods.extend(lods.into_iter().map(|l| l.info));
     }
     bar.finish();
     results.sort(&plan.case_ids());
-    Ok((
-        results,
-        engine.fallback().map(str::to_string).into_iter().collect(),
-    ))
+    let mut warnings: Vec<String> = engine.fallback().map(str::to_string).into_iter().collect();
+    warnings.extend(export_warnings);
+    Ok((results, warnings))
 }
 
 /// A scene of `mesh` with the config's lights, background and ambient term.

@@ -36,6 +36,7 @@ pub mod surface_distance;
 mod texture;
 mod validate;
 mod weld;
+pub mod write_gltf;
 pub mod write_obj;
 
 use std::path::{Path, PathBuf};

@@ -7,6 +7,8 @@
 //!   (skipped only when `../shared` is absent) and on the shipped `reference/models`.
 //! - `eval`: the batch evaluator (determinism, shards, gate, golden images, bad configs, LOD
 //!   chains on every shipped model).
+//! - `export`: LOD chains as glTF with `MSFT_lod` and measured `MSFT_screencoverage`, from
+//!   `eval` and `simplify`, read back with the `gltf` crate.
 //! - `fuzz`: property-based mutation fuzzing of the OBJ, PLY, OFF and GLB paths.
 //! - `hostile`: hostile input by class (`hostile/mod.rs` lists them): refused with exit 2, never
 //!   an abort, a hang or a silently wrong pass.
@@ -29,6 +31,7 @@ mod bad_input;
 mod cli;
 mod common;
 mod eval;
+mod export;
 mod fuzz;
 #[cfg(feature = "gpu")]
 mod gpu;
