@@ -14,8 +14,12 @@ pub enum DiffMetric {
     Ssim,
     /// MS-SSIM (sRGB luma) in [0, 1].
     Msssim,
-    /// PSNR of linear luminance, dB.
+    /// PSNR of the 8-bit sRGB encodings over all three channels (as scikit-image, ffmpeg and
+    /// idiff report it), dB.
     Psnr,
+    /// PSNR of linear Rec. 709 luminance (peak 1), dB.
+    #[serde(rename = "psnr_luminance")]
+    PsnrLuminance,
     /// MSE of linear luminance.
     Mse,
     /// Visible-difference predictor: value = detection probability in [0, 1]; `jnd` also given.
@@ -24,11 +28,12 @@ pub enum DiffMetric {
 
 impl DiffMetric {
     /// Every metric `diff` can compute, in output order.
-    pub const ALL: [DiffMetric; 6] = [
+    pub const ALL: [DiffMetric; 7] = [
         DiffMetric::Flip,
         DiffMetric::Ssim,
         DiffMetric::Msssim,
         DiffMetric::Psnr,
+        DiffMetric::PsnrLuminance,
         DiffMetric::Mse,
         DiffMetric::Vdp,
     ];
@@ -94,6 +99,7 @@ impl DiffMetric {
             DiffMetric::Ssim => "ssim",
             DiffMetric::Msssim => "msssim",
             DiffMetric::Psnr => "psnr",
+            DiffMetric::PsnrLuminance => "psnr_luminance",
             DiffMetric::Mse => "mse",
             DiffMetric::Vdp => "vdp",
         }
@@ -250,7 +256,7 @@ pub fn diff(
             note: None,
             jnd: None,
             backend: match metric {
-                DiffMetric::Flip | DiffMetric::Mse | DiffMetric::Psnr => engine.describe(),
+                DiffMetric::Flip | DiffMetric::Mse | DiffMetric::PsnrLuminance => engine.describe(),
                 _ => crate::backend::CPU_RENDERER.to_string(),
             },
             worst_pixel: None,
@@ -310,7 +316,10 @@ pub fn diff(
                 DiffMetric::Msssim => {
                     r.value = Some(ssim::ms_ssim(&a, &b, ssim::SsimInput::SrgbLuma)?)
                 }
-                DiffMetric::Psnr => r.value = Some(engine.mse(&a, &b)?.psnr_db),
+                DiffMetric::Psnr => {
+                    r.value = Some(crate::metric::mse::psnr_srgb8(&a, &b)?);
+                }
+                DiffMetric::PsnrLuminance => r.value = Some(engine.mse(&a, &b)?.psnr_db),
                 DiffMetric::Mse => r.value = Some(engine.mse(&a, &b)?.mse),
                 DiffMetric::Vdp => {
                     let s = vdp.compare(&a, &b)?;

@@ -100,7 +100,7 @@ fn table(r: &CompareReport) -> String {
             // The worst view in the metric's own direction (lowest SSIM and PSNR).
             let x = match (label, *m) {
                 ("mean", _) => r.summary.iter().find(|x| x.metric == *m).map(|x| x.mean),
-                (_, "ssim" | "psnr") => values.reduce(f64::min),
+                (_, "ssim" | "psnr" | "psnr_luminance") => values.reduce(f64::min),
                 _ => values.reduce(f64::max),
             };
             s.push_str(&x.map_or(format!(" {:>9}", "-"), |x| format!(" {x:>9.4}")));
@@ -122,6 +122,6 @@ fn table(r: &CompareReport) -> String {
             ));
         }
     }
-    s.push_str("\nflip: mean ꟻLIP (0 same … 1), ssim (1 same), psnr (dB, linear luminance), vdp: detection probability, vdp_jnd: JND (1 = threshold)\n");
+    s.push_str("\nflip: mean ꟻLIP (0 same … 1), ssim (1 same), psnr (dB, 8-bit sRGB), vdp: detection probability, vdp_jnd: JND (1 = threshold)\n");
     s
 }

@@ -18,8 +18,11 @@ pub(crate) enum MetricArg {
     Ssim,
     /// Multi-scale SSIM (images of at least 176×176).
     Msssim,
-    /// PSNR of linear luminance.
+    /// PSNR of the 8-bit sRGB encodings, all three channels (as scikit-image, ffmpeg, idiff).
     Psnr,
+    /// PSNR of linear luminance (peak 1).
+    #[value(name = "psnr-luminance")]
+    PsnrLuminance,
     /// MSE of linear luminance.
     Mse,
     /// The visible-difference predictor (probability and JND).
@@ -36,6 +39,7 @@ impl MetricArg {
             MetricArg::Ssim => vec![DiffMetric::Ssim],
             MetricArg::Msssim => vec![DiffMetric::Msssim],
             MetricArg::Psnr => vec![DiffMetric::Psnr],
+            MetricArg::PsnrLuminance => vec![DiffMetric::PsnrLuminance],
             MetricArg::Mse => vec![DiffMetric::Mse],
             MetricArg::Vdp => vec![DiffMetric::Vdp],
             MetricArg::All => DiffMetric::ALL.to_vec(),

@@ -4,7 +4,9 @@
 //! Metric names written to `metrics.csv`:
 //! `flip` (FLIP mean), `flip_p95` (95th percentile of the per-pixel FLIP map), `flip_share` (share
 //! of pixels whose FLIP exceeds `flip_pixel_threshold`), `ssim`, `msssim` (sRGB luma, Wang et al.),
-//! `psnr` (dB) and `mse` (linear luminance), `vdp` (detection probability) and `vdp_jnd`.
+//! `psnr` (dB, 8-bit sRGB over all three channels, as scikit-image, ffmpeg and idiff report it),
+//! `psnr_luminance` (dB) and `mse` (linear Rec. 709 luminance), `vdp` (detection probability)
+//! and `vdp_jnd`.
 
 use super::config::MetricFamily;
 use super::tables::round7;
@@ -121,7 +123,9 @@ impl Scorer {
                 }
                 MetricFamily::Psnr => {
                     let s = mse::mse(&reference.image, test)?;
-                    out.values.push(("psnr", round7(s.psnr_db)));
+                    let rgb = mse::psnr_srgb8(&reference.image, test)?;
+                    out.values.push(("psnr", round7(rgb)));
+                    out.values.push(("psnr_luminance", round7(s.psnr_db)));
                     out.values.push(("mse", round7(s.mse)));
                 }
                 MetricFamily::Vdp => {

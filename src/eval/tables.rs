@@ -233,7 +233,7 @@ fn worst_of(
 
 /// Whether larger values of `metric` mean a larger difference.
 pub fn higher_is_worse(metric: &str) -> bool {
-    !matches!(metric, "ssim" | "msssim" | "psnr")
+    !matches!(metric, "ssim" | "msssim" | "psnr" | "psnr_luminance")
 }
 
 /// Round to 7 significant digits (see the module comment).
@@ -376,13 +376,14 @@ impl Results {
 }
 
 fn metric_rank(m: &str) -> usize {
-    const ORDER: [&str; 9] = [
+    const ORDER: [&str; 10] = [
         "flip",
         "flip_p95",
         "flip_share",
         "ssim",
         "msssim",
         "psnr",
+        "psnr_luminance",
         "mse",
         "vdp",
         "vdp_jnd",

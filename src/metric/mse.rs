@@ -1,4 +1,5 @@
-//! Mean squared error, RMSE and PSNR on luminance, and Lindstrom–Turk's multi-view d_MS.
+//! Mean squared error, RMSE and PSNR on luminance, Lindstrom–Turk's multi-view d_MS, and PSNR
+//! as image tools report it (8-bit sRGB, all three channels).
 //!
 //! Based on: Peter Lindstrom, Greg Turk. Image-Driven Simplification. ACM TOG 2000, eq. 1:
 //! d_MS(Y⁰, Y¹) = 1/(l·m·n) Σ_h Σ_i Σ_j (y⁰_hij − y¹_hij)², the mean squared luminance difference
@@ -74,6 +75,37 @@ pub fn mse(reference: &LinearImage, test: &LinearImage) -> Result<MseScore> {
     Ok(MseScore::from_mse(
         sum_squared(reference, test) / reference.pixels().len() as f64,
     ))
+}
+
+/// PSNR as scikit-image's `peak_signal_noise_ratio`, ffmpeg's `psnr` filter and OpenImageIO's
+/// idiff report it for 8-bit images: both images encoded to 8-bit sRGB (rounded, as a PNG
+/// stores them), the mean squared difference over every pixel and all three channels, and
+/// 10·log10(255² / MSE) in dB, saturating at [`PSNR_CEILING_DB`] for identical encodings.
+pub fn psnr_srgb8(reference: &LinearImage, test: &LinearImage) -> Result<f64> {
+    same_size(reference, test)?;
+    let encode = |v: f32| (crate::color::linear_to_srgb(v.clamp(0.0, 1.0)) * 255.0).round() as i32;
+    let w = reference.width();
+    let rows: Vec<f64> = reference
+        .pixels()
+        .par_chunks(w)
+        .zip(test.pixels().par_chunks(w))
+        .map(|(ra, rb)| {
+            let mut s = 0i64;
+            for (p, q) in ra.iter().zip(rb) {
+                for k in 0..3 {
+                    let d = (encode(p[k]) - encode(q[k])) as i64;
+                    s += d * d;
+                }
+            }
+            s as f64
+        })
+        .collect();
+    let mse = rows.iter().sum::<f64>() / (3 * reference.pixels().len()) as f64;
+    Ok(if mse > 0.0 {
+        (10.0 * (255.0 * 255.0 / mse).log10()).min(PSNR_CEILING_DB)
+    } else {
+        PSNR_CEILING_DB
+    })
 }
 
 /// Lindstrom–Turk's d_MS over a set of views (eq. 1): the mean squared luminance difference over

@@ -150,8 +150,19 @@ fn diff_reports_every_metric_as_json_and_writes_maps() {
         .iter()
         .map(|m| m["metric"].as_str().unwrap())
         .collect();
-    assert_eq!(names, ["flip", "ssim", "msssim", "psnr", "mse", "vdp"]);
-    assert!(v[5]["jnd"].as_f64().unwrap() > 0.0 && v[5]["value"].as_f64().unwrap() <= 1.0);
+    assert_eq!(
+        names,
+        [
+            "flip",
+            "ssim",
+            "msssim",
+            "psnr",
+            "psnr_luminance",
+            "mse",
+            "vdp"
+        ]
+    );
+    assert!(v[6]["jnd"].as_f64().unwrap() > 0.0 && v[6]["value"].as_f64().unwrap() <= 1.0);
     for m in v.as_array().unwrap() {
         assert_eq!(m["ppd"], 40.0);
         assert_eq!(
@@ -190,7 +201,7 @@ fn diff_rejects_bad_requests_with_exit_2() {
         r.code == 2
             && r.stderr.contains("--metric")
             && r.stderr.contains("'nope'")
-            && r.stderr.contains("flip, ssim, msssim, psnr, mse, vdp, all"),
+            && r.stderr.contains("flip, ssim, msssim, psnr, psnr-luminance, mse, vdp, all"),
         "{}",
         r.stderr
     );

@@ -91,8 +91,9 @@ fn outputs_are_identical_for_any_thread_count_and_merged_shards_equal_one_run() 
     assert!(t1.contains_key(Path::new("heatmaps/spot/meshopt-r25/11-flip.png")));
     assert!(t1.contains_key(Path::new("sheets/bunny3k/meshopt-r50.png")));
     let metrics = String::from_utf8(t1[Path::new("metrics.csv")].clone()).unwrap();
-    // 2 assets × 2 LODs × 12 views × (flip, flip_p95, flip_share, ssim, psnr, mse, vdp, vdp_jnd).
-    assert_eq!(metrics.lines().count(), 1 + 2 * 2 * 12 * 8);
+    // 2 assets × 2 LODs × 12 views × (flip, flip_p95, flip_share, ssim, psnr, psnr_luminance, mse,
+    // vdp, vdp_jnd).
+    assert_eq!(metrics.lines().count(), 1 + 2 * 2 * 12 * 9);
     // Two shards, merged, equal the single run byte for byte; each shard has work.
     for s in ["0/2", "1/2"] {
         let o = out(&format!("shard{}", &s[..1]));

@@ -141,3 +141,28 @@ fn ssim_and_psnr_match_scikit_image() {
     }
     assert!(checked.0 >= 8 && checked.1 >= 10, "{checked:?}");
 }
+
+#[test]
+fn psnr_of_the_8_bit_encodings_matches_scikit_image() {
+    // `psnr` as scikit-image, ffmpeg and idiff report it: the stored 8-bit sRGB values, all three
+    // channels, peak 255 (reference/oracles/make_psnr_srgb8.py). Loading decodes to linear light
+    // and the metric re-encodes, so this also checks that the round trip gives the file's bytes.
+    let text = std::fs::read_to_string(root().join("reference/oracles/psnr_srgb8.json")).unwrap();
+    let v: serde_json::Value = serde_json::from_str(&text).unwrap();
+    let mut checked = 0;
+    for entry in v["psnr_srgb8"].as_array().unwrap() {
+        let load = |k: &str| LinearImage::load(&root().join(entry[k].as_str().unwrap())).unwrap();
+        let ours = lodeval::metric::mse::psnr_srgb8(&load("reference"), &load("test")).unwrap();
+        let expected = entry["psnr_db"].as_f64().unwrap();
+        assert!(
+            (ours - expected).abs() <= 1e-9,
+            "{}: PSNR {ours} vs {expected}",
+            entry["name"]
+        );
+        checked += 1;
+    }
+    assert!(checked >= 10, "{checked}");
+    // Identical images read the 100 dB ceiling (scikit-image says infinity).
+    let a = LinearImage::load(&root().join("reference/oracles/flip/lines_70_ref.png")).unwrap();
+    assert_eq!(lodeval::metric::mse::psnr_srgb8(&a, &a).unwrap(), 100.0);
+}

@@ -44,13 +44,14 @@ pub fn bench_metrics(reference: &Path, test: &Path, runs: usize) -> Result<Vec<M
         &crate::scene::Viewing::DEFAULT,
         crate::metric::vdp::Display::DEFAULT,
     );
-    let cases: [(&str, &dyn Fn() -> Result<f64>); 4] = [
+    let cases: [(&str, &dyn Fn() -> Result<f64>); 5] = [
         ("flip", &|| flip.compare(&a, &b).map(|s| s.mean)),
         ("vdp", &|| vdp.compare(&a, &b).map(|s| s.jnd)),
         ("ssim", &|| {
             ssim::ssim(&a, &b, ssim::SsimInput::SrgbLuma).map(|s| s.0)
         }),
-        ("psnr", &|| mse::mse(&a, &b).map(|s| s.psnr_db)),
+        ("psnr", &|| mse::psnr_srgb8(&a, &b)),
+        ("psnr_luminance", &|| mse::mse(&a, &b).map(|s| s.psnr_db)),
     ];
     cases
         .iter()
