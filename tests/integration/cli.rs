@@ -201,7 +201,8 @@ fn diff_rejects_bad_requests_with_exit_2() {
         r.code == 2
             && r.stderr.contains("--metric")
             && r.stderr.contains("'nope'")
-            && r.stderr.contains("flip, ssim, msssim, psnr, psnr-luminance, mse, vdp, all"),
+            && r.stderr
+                .contains("flip, ssim, msssim, psnr, psnr-luminance, mse, vdp, all"),
         "{}",
         r.stderr
     );

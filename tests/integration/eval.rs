@@ -533,3 +533,92 @@ fn the_shipped_ci_config_passes_its_gate_and_matches_its_goldens() {
     assert_eq!(r.code, 0, "{}{}", r.stdout, r.stderr);
     assert!(r.stdout.contains("24 image(s) match"), "{}", r.stdout);
 }
+
+#[test]
+fn the_example_ci_files_set_the_variables_lodeval_reads() {
+    use lodeval::eval::Shard;
+    let read = |f: &str| {
+        std::fs::read_to_string(crate::common::root().join("examples/ci").join(f)).unwrap()
+    };
+    // The value after `key:` on its line (first occurrence).
+    let value = |text: &str, key: &str| -> String {
+        text.lines()
+            .find_map(|l| l.trim().strip_prefix(key))
+            .unwrap_or_else(|| panic!("{key} missing"))
+            .trim()
+            .trim_matches('"')
+            .to_string()
+    };
+    // Every index of a run of `count` jobs gets its own shard, and together they cover all.
+    let check = |env: &dyn Fn(usize) -> Vec<(&'static str, String)>, jobs: usize, count: u32| {
+        let mut seen = Vec::new();
+        for j in 0..jobs {
+            let vars = env(j);
+            let s = Shard::from_env(|k| vars.iter().find(|(n, _)| *n == k).map(|(_, v)| v.clone()))
+                .unwrap()
+                .expect("the variables select a shard");
+            assert_eq!(s.count, count);
+            seen.push(s.index);
+        }
+        seen.sort_unstable();
+        assert_eq!(seen, (0..count).collect::<Vec<_>>());
+    };
+    // GitHub Actions: a matrix of shard indices, TEST_SHARD_INDEX from it, TEST_TOTAL_SHARDS.
+    let gh = read("github-actions.yml");
+    let matrix: Vec<u32> = value(&gh, "shard: [")
+        .trim_matches(|c| c == ']')
+        .split(',')
+        .map(|v| v.trim().parse().unwrap())
+        .collect();
+    assert_eq!(value(&gh, "TEST_SHARD_INDEX:"), "${{ matrix.shard }}");
+    let total: u32 = value(&gh, "TEST_TOTAL_SHARDS:").parse().unwrap();
+    assert_eq!(matrix.len() as u32, total);
+    check(
+        &|j| {
+            vec![
+                ("TEST_SHARD_INDEX", matrix[j].to_string()),
+                ("TEST_TOTAL_SHARDS", total.to_string()),
+            ]
+        },
+        matrix.len(),
+        total,
+    );
+    assert!(
+        gh.contains("lodeval merge"),
+        "the workflow merges and gates"
+    );
+    // GitLab: `parallel: N` sets CI_NODE_INDEX (1-based) and CI_NODE_TOTAL.
+    let gl = read("gitlab-ci.yml");
+    let n: u32 = value(&gl, "parallel:").parse().unwrap();
+    check(
+        &|j| {
+            vec![
+                ("CI_NODE_INDEX", (j + 1).to_string()),
+                ("CI_NODE_TOTAL", n.to_string()),
+            ]
+        },
+        n as usize,
+        n,
+    );
+    assert!(gl.contains("lodeval merge"));
+    // Kubernetes: an Indexed Job sets JOB_COMPLETION_INDEX; the file sets LODEVAL_SHARD_COUNT
+    // to its `completions`.
+    let k8s = read("kubernetes-indexed-job.yaml");
+    assert_eq!(value(&k8s, "completionMode:"), "Indexed");
+    let completions: u32 = value(&k8s, "completions:").parse().unwrap();
+    let pos = k8s
+        .find("name: LODEVAL_SHARD_COUNT")
+        .expect("the shard count is set");
+    let count: u32 = value(&k8s[pos..], "value:").parse().unwrap();
+    assert_eq!(count, completions);
+    check(
+        &|j| {
+            vec![
+                ("JOB_COMPLETION_INDEX", j.to_string()),
+                ("LODEVAL_SHARD_COUNT", count.to_string()),
+            ]
+        },
+        completions as usize,
+        completions,
+    );
+}
