@@ -14,9 +14,11 @@ use super::print::emit;
 pub(crate) struct GoldenArgs {
     /// The batch config whose renders are checked.
     pub(crate) config: PathBuf,
-    /// Write the current renders as the new goldens (refused when CI is set).
-    #[arg(long)]
-    pub(crate) bless: bool,
+    /// Write the current renders as the new goldens (refused when CI is set); with filters
+    /// (ASSET, ASSET/LOD or ASSET/LOD/VIEW, LOD `original` for the original) only those, and
+    /// the rest are compared.
+    #[arg(long, num_args = 0.., value_name = "FILTER")]
+    pub(crate) bless: Option<Vec<String>>,
     /// Where actual and diff images of mismatches go (default: the config's output folder).
     #[arg(long, value_name = "DIR")]
     pub(crate) out: Option<PathBuf>,
@@ -27,29 +29,42 @@ pub(crate) fn run(a: GoldenArgs) -> Result<(), Error> {
     let plan = lodeval::eval::Plan::load(&a.config)?;
     let out = plan.config.out_dir(&plan.config_path, a.out.as_deref());
     let ci = std::env::var_os("CI").is_some_and(|v| !v.is_empty());
-    let g = lodeval::eval::golden::run(&plan, a.bless, ci, &out)?;
+    use lodeval::eval::golden::Bless;
+    let bless = match a.bless {
+        None => Bless::No,
+        Some(f) if f.is_empty() => Bless::All,
+        Some(f) => Bless::Only(f),
+    };
+    let g = lodeval::eval::golden::run(&plan, &bless, ci, &out)?;
     let dir = lodeval::eval::golden::golden_dir(&plan);
-    if a.bless {
-        return emit(&format!(
+    let report = g
+        .report
+        .as_ref()
+        .map_or(String::new(), |r| format!("; report: {}", r.display()));
+    if g.blessed > 0 {
+        emit(&format!(
             "blessed {} golden image(s) in {}\n",
-            g.checked,
+            g.blessed,
             dir.display()
-        ));
+        ))?;
     }
     for m in &g.mismatches {
         note!("{m}");
     }
     if g.mismatches.is_empty() {
         emit(&format!(
-            "{} image(s) match their goldens in {}\n",
-            g.checked,
+            "{} image(s) match their goldens in {}{report}\n",
+            g.checked - g.blessed,
             dir.display()
         ))
     } else {
         Err(Error::Regression(format!(
-            "{} of {} image(s) differ from their goldens; if the change is intended, run: lodeval golden {} --bless",
+            "{} of {} image(s) differ from their goldens (pending -actual.png files and the \
+             report in {}{report}); to accept them: lodeval golden {} --bless, or one at a time \
+             with --bless ASSET/LOD/VIEW",
             g.mismatches.len(),
             g.checked,
+            out.join("golden").display(),
             a.config.display()
         )))
     }

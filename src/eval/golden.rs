@@ -6,6 +6,11 @@
 //! output folder (`golden/ASSET/LOD/view-NN-actual.png`, `-diff.png`) and the exact bless command
 //! is printed. `--bless` writes new goldens and refuses when the `CI` environment variable is set.
 //!
+//! Every run also writes `golden/report.html` (`golden_report.rs`): the mismatches first, each as
+//! expected | actual | diff with a slider between expected and actual. `--bless ASSET[/LOD[/VIEW]]`
+//! blesses only the images a filter names and compares the rest, as insta and Playwright accept
+//! one snapshot at a time; the mismatches' `-actual.png` files are the pending ones.
+//!
 //! Decision: both sides are compared as 8-bit sRGB (the render is quantised exactly as the golden
 //! PNG was), so a clean checkout compares equal to its own goldens to the bit.
 
@@ -26,10 +31,85 @@ use crate::raster;
 pub struct GoldenOutcome {
     /// Images compared (or blessed).
     pub checked: usize,
+    /// Images blessed.
+    pub blessed: usize,
     /// One line per mismatch or missing golden.
     pub mismatches: Vec<String>,
     /// Files written (blessed goldens, or actual/diff images of mismatches).
     pub written: Vec<PathBuf>,
+    /// Every image and what became of it, for the report.
+    pub images: Vec<GoldenImage>,
+    /// The report written (`golden/report.html` in the output folder).
+    pub report: Option<PathBuf>,
+}
+
+/// One golden image's check.
+#[derive(Debug, Clone)]
+pub struct GoldenImage {
+    /// Asset, LOD (`original` for the original) and view.
+    pub asset: String,
+    /// LOD name.
+    pub lod: String,
+    /// View index.
+    pub view: usize,
+    /// The golden file.
+    pub golden: PathBuf,
+    /// What happened.
+    pub status: GoldenStatus,
+}
+
+/// See [`GoldenImage::status`].
+#[derive(Debug, Clone)]
+pub enum GoldenStatus {
+    /// Within tolerance.
+    Match,
+    /// Written as the new golden.
+    Blessed,
+    /// Outside tolerance or missing: why, the actual render, and the heat map where the sizes
+    /// agree.
+    Mismatch {
+        /// The reason.
+        why: String,
+        /// The pending actual render.
+        actual: PathBuf,
+        /// The FLIP heat map.
+        diff: Option<PathBuf>,
+    },
+}
+
+/// Which images `--bless` writes.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum Bless {
+    /// None: compare everything.
+    No,
+    /// Every image.
+    All,
+    /// The images a filter names (`ASSET`, `ASSET/LOD` or `ASSET/LOD/VIEW`); the rest are
+    /// compared.
+    Only(Vec<String>),
+}
+
+impl Bless {
+    /// Whether the image of `asset`, `lod`, `view` is blessed.
+    pub fn covers(&self, asset: &str, lod: &str, view: usize) -> bool {
+        match self {
+            Bless::No => false,
+            Bless::All => true,
+            Bless::Only(filters) => filters.iter().any(|f| {
+                let parts: Vec<&str> = f.split('/').collect();
+                parts.first() == Some(&asset)
+                    && parts.get(1).is_none_or(|l| *l == lod)
+                    && parts
+                        .get(2)
+                        .is_none_or(|v| v.trim_start_matches("view-").parse::<usize>() == Ok(view))
+            }),
+        }
+    }
+
+    /// Whether any image is blessed at all.
+    pub fn any(&self) -> bool {
+        *self != Bless::No
+    }
 }
 
 /// The golden folder of a plan.
@@ -49,8 +129,8 @@ pub fn golden_dir(plan: &Plan) -> PathBuf {
 
 /// Compare (or with `bless`, write) the goldens of `plan`. `ci` says whether the `CI` environment
 /// variable is set; `out_dir` receives actual and diff images of mismatches.
-pub fn run(plan: &Plan, bless: bool, ci: bool, out_dir: &Path) -> Result<GoldenOutcome> {
-    if bless && ci {
+pub fn run(plan: &Plan, bless: &Bless, ci: bool, out_dir: &Path) -> Result<GoldenOutcome> {
+    if bless.any() && ci {
         return Err(Error::Usage(
             "refusing to bless golden images with CI set: goldens are updated by a person, \
              on purpose; run `lodeval golden CONFIG --bless` locally and commit the images"
@@ -59,6 +139,30 @@ pub fn run(plan: &Plan, bless: bool, ci: bool, out_dir: &Path) -> Result<GoldenO
     }
     let cfg = &plan.config;
     let dir = golden_dir(plan);
+    // Every filter must name something the plan renders: a typo blesses nothing silently.
+    if let Bless::Only(filters) = bless {
+        for f in filters {
+            let parts: Vec<&str> = f.split('/').collect();
+            let asset = plan.assets.iter().find(|a| a.name == parts[0]);
+            let lod_ok = |a: &super::plan::AssetPlan| {
+                parts.get(1).is_none_or(|l| {
+                    *l == "original" || (cfg.golden.lods && a.lods.iter().any(|x| x.name == *l))
+                })
+            };
+            let view_ok = parts.get(2).is_none_or(|v| {
+                v.trim_start_matches("view-")
+                    .parse::<usize>()
+                    .is_ok_and(|v| v < cfg.render.rig.0.directions().len())
+            });
+            if parts.len() > 3 || !asset.is_some_and(lod_ok) || !view_ok {
+                return Err(Error::Usage(format!(
+                    "--bless {f}: no golden image matches; give ASSET, ASSET/LOD or \
+                     ASSET/LOD/VIEW with an asset of the config, a LOD of it (or `original`) and \
+                     a view number of the rig"
+                )));
+            }
+        }
+    }
     // Mismatch images of an earlier run go first, so what is left is this run's.
     let mut inputs = plan.input_files();
     inputs.push(dir.clone());
@@ -85,9 +189,19 @@ pub fn run(plan: &Plan, bless: bool, ci: bool, out_dir: &Path) -> Result<GoldenO
                 let golden_path = dir.join(&rel);
                 let actual = raster::render(&scene, cam, &settings)?.to_srgb8();
                 outcome.checked += 1;
-                if bless {
+                let mut record = GoldenImage {
+                    asset: asset.name.clone(),
+                    lod: name.clone(),
+                    view: v,
+                    golden: golden_path.clone(),
+                    status: GoldenStatus::Match,
+                };
+                if bless.covers(&asset.name, &name, v) {
                     crate::io::write_image(&golden_path, &image::DynamicImage::ImageRgb8(actual))?;
                     outcome.written.push(golden_path);
+                    outcome.blessed += 1;
+                    record.status = GoldenStatus::Blessed;
+                    outcome.images.push(record);
                     continue;
                 }
                 let problem = compare(&flip, &golden_path, &actual, cfg)?;
@@ -101,17 +215,31 @@ pub fn run(plan: &Plan, bless: bool, ci: bool, out_dir: &Path) -> Result<GoldenO
                         golden_path.display(),
                         actual_path.display()
                     );
+                    let mut diff_out = None;
                     if let Some(diff) = diff {
                         let diff_path = base.with_file_name(format!("view-{v:02}-diff.png"));
                         crate::io::write_image(&diff_path, &image::DynamicImage::ImageRgb8(diff))?;
                         line.push_str(&format!(", diff: {}", diff_path.display()));
-                        outcome.written.push(diff_path);
+                        outcome.written.push(diff_path.clone());
+                        diff_out = Some(diff_path);
                     }
                     outcome.mismatches.push(line);
+                    record.status = GoldenStatus::Mismatch {
+                        why,
+                        actual: actual_path,
+                        diff: diff_out,
+                    };
                 }
+                outcome.images.push(record);
             }
         }
     }
+    let report = out_dir.join("golden").join("report.html");
+    crate::io::write_atomic(
+        &report,
+        super::golden_report::render(&plan.config_path, &outcome)?.as_bytes(),
+    )?;
+    outcome.report = Some(report);
     Ok(outcome)
 }
 

@@ -25,6 +25,7 @@ pub mod distance;
 pub mod export;
 pub mod gate;
 pub mod golden;
+pub mod golden_report;
 pub mod junit;
 mod manifest;
 pub mod out;

@@ -367,6 +367,78 @@ fn golden_images_compare_mismatch_bless_and_refuse_under_ci() {
     assert!(r.stderr.contains("view-03.png"), "{}", r.stderr);
     let out = dir.path().join("out/golden/bunny3k/original");
     assert!(out.join("view-03-actual.png").exists() && out.join("view-03-diff.png").exists());
+    // The report shows the mismatch first, with expected, actual, diff and the wipe slider.
+    let report = dir.path().join("out/golden/report.html");
+    let html = std::fs::read_to_string(&report).unwrap();
+    assert!(html.contains("<b>1</b> of 12 image(s) differ"), "{html}");
+    assert!(html.contains("bunny3k/original/view 3"), "{html}");
+    assert_eq!(
+        html.matches("data:image/png;base64,").count(),
+        5,
+        "expected, actual, diff, and both in the wipe"
+    );
+    assert!(html.contains("type=\"range\""));
+    golden_report_renders_in_chromium(&report, dir.path());
+    // A filter that names nothing is refused; one that names the view blesses only it.
+    let r = lodeval_ci(&["golden", c, "--bless", "bunny3k/original/99"], false);
+    assert_eq!(r.code, 2, "{}", r.stderr);
+    let r = lodeval_ci(&["golden", c, "--bless", "nope"], false);
+    assert_eq!(r.code, 2, "{}", r.stderr);
+    let other = dir.path().join("golden/bunny3k/original/view-05.png");
+    let before = std::fs::read(&other).unwrap();
+    let r = lodeval_ci(&["golden", c, "--bless", "bunny3k/original/3"], false);
+    assert_eq!(r.code, 0, "{}", r.stderr);
+    assert!(
+        r.stdout.contains("blessed 1 golden image(s)"),
+        "{}",
+        r.stdout
+    );
+    assert!(r.stdout.contains("11 image(s) match"), "{}", r.stdout);
+    assert_eq!(
+        std::fs::read(&other).unwrap(),
+        before,
+        "other goldens are untouched"
+    );
+    let r = lodeval_ci(&["golden", c], true);
+    assert_eq!(r.code, 0, "{}", r.stderr);
+}
+
+/// The golden report in headless Chromium: the failing row's tint and the images are drawn.
+fn golden_report_renders_in_chromium(report: &Path, dir: &Path) {
+    let Some(browser) = chromium() else {
+        assert!(
+            std::env::var_os("CI").is_none(),
+            "Chromium is required under CI for the report screenshot test"
+        );
+        eprintln!("SKIPPED: no chromium on this machine (apt-get install chromium)");
+        return;
+    };
+    let shot = dir.join("golden-shot.png");
+    let out = Command::new(&browser)
+        .args([
+            "--headless",
+            "--no-sandbox",
+            "--disable-gpu",
+            "--hide-scrollbars",
+            "--window-size=1400,700",
+            &format!("--screenshot={}", shot.display()),
+        ])
+        .arg(format!("file://{}", report.display()))
+        .output()
+        .unwrap();
+    assert!(shot.exists(), "{}", String::from_utf8_lossy(&out.stderr));
+    let img = image::open(&shot).unwrap().to_rgb8();
+    let count = |f: &dyn Fn(&image::Rgb<u8>) -> bool| img.pixels().filter(|p| f(p)).count();
+    // The failing row's tint (#fde2e2), its red edge (#c0392b), the painted block in the golden
+    // (pure red) and the renders' mid-grey background.
+    let tint = count(&|p| p.0 == [0xfd, 0xe2, 0xe2]);
+    let edge = count(&|p| p.0 == [0xc0, 0x39, 0x2b]);
+    let red = count(&|p| p.0[0] > 240 && p.0[1] < 20 && p.0[2] < 20);
+    let grey = count(&|p| (p.0[0] as i32 - 128).abs() < 6 && p.0[0] == p.0[1] && p.0[1] == p.0[2]);
+    assert!(
+        tint > 5_000 && edge > 500 && red > 200 && grey > 20_000,
+        "tint {tint} edge {edge} red {red} grey {grey}"
+    );
 }
 
 /// Per LOD, in chain order: (FLIP mean over views, VDP imperceptibility distance).
