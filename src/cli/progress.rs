@@ -11,6 +11,15 @@ use lodeval::progress::Progress;
 /// Interval between progress lines when stderr is not a terminal.
 const LOG_EVERY: Duration = Duration::from_secs(5);
 
+/// [`LOG_EVERY`], or `LODEVAL_PROGRESS_EVERY_MS` milliseconds where that is set (a CI that
+/// wants denser or sparser lines; the tests use it to see the lines of a short run).
+fn log_every() -> Duration {
+    std::env::var("LODEVAL_PROGRESS_EVERY_MS")
+        .ok()
+        .and_then(|v| v.trim().parse::<u64>().ok())
+        .map_or(LOG_EVERY, Duration::from_millis)
+}
+
 /// A stage as the log-line form tracks it.
 #[derive(Debug)]
 pub(crate) struct Stage {
@@ -66,7 +75,7 @@ impl Stage {
 
     /// Print a line if the last one is old enough.
     fn tick(&mut self) {
-        if self.last_line.elapsed() >= LOG_EVERY {
+        if self.last_line.elapsed() >= log_every() {
             self.last_line = Instant::now();
             note!("{}", self.line());
         }
@@ -194,8 +203,13 @@ impl Progress for Reporter {
                 }
             }
             Reporter::Log(slot) => {
-                if let Ok(mut s) = slot.lock() {
-                    s.take();
+                // The last line says where the stage ended, however recent the one before.
+                if let Ok(mut s) = slot.lock()
+                    && let Some(st) = s.take()
+                    && st.total.is_some()
+                    && st.done > 0
+                {
+                    note!("{}", st.line());
                 }
             }
         }

@@ -449,3 +449,43 @@ fn completions_man_pages_and_help_with_examples_and_exit_codes() {
         );
     }
 }
+
+#[test]
+fn progress_in_a_log_is_a_line_every_few_seconds_and_quiet_silences_it() {
+    // Standard error is a pipe here, as in CI: lines, no bar. LODEVAL_PROGRESS_EVERY_MS makes
+    // them come at once for a short run.
+    let dir = tempfile::tempdir().unwrap();
+    let cfg = dir.path().join("p.toml");
+    std::fs::write(
+        &cfg,
+        format!(
+            "out = \"out\"\nmetrics = [\"flip\"]\n[render]\nsize = 48\nrig = \"icosahedron\"\n\
+             [distance]\nenabled = false\n[images]\nheatmaps = \"none\"\ncontact_sheets = false\n\
+             [[asset]]\nname = \"bunny3k\"\nmesh = \"{}\"\ngenerate = {{ method = \"meshopt\", ratios = [0.5] }}\n",
+            model("bunny/bunny_odedstein_3k.obj").display()
+        ),
+    )
+    .unwrap();
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_lodeval"))
+        .args(["eval", cfg.to_str().unwrap()])
+        .env("LODEVAL_PROGRESS_EVERY_MS", "0")
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(0));
+    let err = String::from_utf8_lossy(&out.stderr);
+    let lines: Vec<&str> = err.lines().filter(|l| l.contains(" renders")).collect();
+    assert!(lines.len() >= 2, "{err}");
+    // `[hh:mm:ss] done/total renders  message`, ending at 12/12.
+    assert!(lines.iter().all(|l| l.starts_with("[00:00:")), "{err}");
+    assert!(lines.last().unwrap().contains("12/12 renders"), "{err}");
+    assert!(
+        !err.contains('\r') && !err.contains("\u{1b}["),
+        "no terminal control codes: {err}"
+    );
+    let quiet = std::process::Command::new(env!("CARGO_BIN_EXE_lodeval"))
+        .args(["eval", cfg.to_str().unwrap(), "--quiet"])
+        .env("LODEVAL_PROGRESS_EVERY_MS", "0")
+        .output()
+        .unwrap();
+    assert!(!String::from_utf8_lossy(&quiet.stderr).contains(" renders"));
+}
