@@ -228,6 +228,14 @@ pub const REMESH_GAMMA: Bound<f64> = Bound {
     why: "a map raised beyond the 10th power leaves single precision's range",
 };
 
+/// Exposures of HDR-FLIP (`diff --num-exposures`): each is a full LDR-FLIP of the pair.
+pub const EXPOSURES: Bound<u64> = Bound {
+    min: 1,
+    max: 64,
+    unit: "exposures",
+    why: "64 exposures span far more than any display's range; each costs a whole FLIP",
+};
+
 /// A mesh's size: its bounding-box diagonal in model units. Squared triangle areas (fourth
 /// powers of lengths) are formed in single precision, whose range is about 1e±38.
 pub const MESH_EXTENT: Bound<f64> = Bound {

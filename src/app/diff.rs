@@ -78,6 +78,9 @@ pub struct DiffResult {
     /// With a per-pixel threshold: the share of pixels (0–1) whose map value exceeds it.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub share_over: Option<f64>,
+    /// FLIP on two EXR (linear, high-dynamic-range) images is HDR-FLIP: the exposures it used.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub exposures: Option<crate::metric::hdr_flip::Exposures>,
 }
 
 /// The worst pixel of a per-pixel map.
@@ -174,6 +177,8 @@ pub struct DiffOptions<'a> {
     pub lenient: bool,
     /// A per-pixel threshold: each per-pixel map also gives the share of pixels above it.
     pub pixel_threshold: Option<f64>,
+    /// HDR-FLIP's exposure range for EXR pairs (else the automatic one).
+    pub exposures: Option<crate::metric::hdr_flip::Exposures>,
 }
 
 /// Where and on what the compared images are seen.
@@ -202,7 +207,16 @@ pub fn diff(
         map,
         lenient,
         pixel_threshold,
+        exposures,
     } = *options;
+    // Two EXR files are linear, high-dynamic-range images: FLIP on them is HDR-FLIP, as NVIDIA's
+    // tool decides by the files.
+    let is_exr = |p: &Path| {
+        p.extension()
+            .and_then(|e| e.to_str())
+            .is_some_and(|e| e.eq_ignore_ascii_case("exr"))
+    };
+    let hdr = is_exr(reference) && is_exr(test);
     use crate::metric::{LinearImage, colormap, flip::Flip, pool, ssim};
     let (a, b) = (LinearImage::load(reference)?, LinearImage::load(test)?);
     if (a.width(), a.height()) != (b.width(), b.height()) {
@@ -261,13 +275,29 @@ pub fn diff(
             },
             worst_pixel: None,
             share_over: None,
+            exposures: None,
         };
         // The metric's per-pixel map, larger is worse, where it has one.
         let mut per_pixel: Option<Vec<f32>> = None;
         let mut compute = || -> Result<()> {
             match metric {
                 DiffMetric::Flip => {
-                    let s = engine.flip(&Flip::new(ppd as f32), &a, &b)?;
+                    let s = if hdr {
+                        let h = crate::metric::hdr_flip::hdr_flip(
+                            &Flip::new(ppd as f32),
+                            &a,
+                            &b,
+                            exposures,
+                        )?;
+                        r.exposures = Some(h.exposures);
+                        r.backend = crate::backend::CPU_RENDERER.to_string();
+                        crate::metric::flip::FlipScore {
+                            mean: h.mean,
+                            map: h.map,
+                        }
+                    } else {
+                        engine.flip(&Flip::new(ppd as f32), &a, &b)?
+                    };
                     let v = &s.map.values;
                     let mut p = std::collections::BTreeMap::new();
                     for q in [25.0, 50.0, 75.0, 95.0, 99.0] {

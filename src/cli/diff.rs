@@ -110,6 +110,17 @@ pub(crate) struct DiffArgs {
     /// The per-pixel threshold of --fail-percent and --warn-percent, in the map's units (0–1).
     #[arg(long)]
     pub(crate) fail_pixel: Option<f64>,
+    /// HDR-FLIP (two EXR images): the shortest exposure, in stops (with --stop-exposure and
+    /// --num-exposures; default: NVIDIA's automatic range from the reference's peak and median).
+    #[arg(long, allow_negative_numbers = true, requires_all = ["stop_exposure", "num_exposures"])]
+    pub(crate) start_exposure: Option<f64>,
+    /// HDR-FLIP: the longest exposure, in stops.
+    #[arg(long, allow_negative_numbers = true, requires_all = ["start_exposure", "num_exposures"])]
+    pub(crate) stop_exposure: Option<f64>,
+    /// HDR-FLIP: the number of exposures, 1 to 64.
+    #[arg(long, requires_all = ["start_exposure", "stop_exposure"],
+          value_parser = super::args::count::<usize>(&lodeval::limits::EXPOSURES))]
+    pub(crate) num_exposures: Option<usize>,
     /// Also write every result as CSV here (reference, test, metric, value, the worst pixel, the
     /// share over --fail-pixel, the verdict).
     #[arg(long)]
@@ -222,6 +233,12 @@ pub(crate) fn run(a: DiffArgs) -> Result<(), Error> {
                 map: map.as_deref(),
                 lenient,
                 pixel_threshold: a.fail_pixel,
+                exposures: match (a.start_exposure, a.stop_exposure, a.num_exposures) {
+                    (Some(start), Some(stop), Some(count)) => {
+                        Some(lodeval::metric::hdr_flip::Exposures { start, stop, count })
+                    }
+                    _ => None,
+                },
             },
         )?;
         let gate_row = results.iter().find(|r| r.metric == gated);
@@ -322,6 +339,12 @@ fn line(r: &lodeval::app::DiffResult) -> String {
     }
     if let Some(j) = r.jnd {
         text.push_str(&format!("  ({j:.3} JND, {:.2} ppd)", r.ppd));
+    }
+    if let Some(e) = r.exposures {
+        text.push_str(&format!(
+            "  HDR-FLIP over {} exposures from {:.4} to {:.4} stops",
+            e.count, e.start, e.stop
+        ));
     }
     if let Some(w) = r.worst_pixel {
         text.push_str(&format!("  worst pixel ({}, {}): {:.4}", w.x, w.y, w.value));

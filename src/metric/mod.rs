@@ -8,6 +8,7 @@
 pub mod colormap;
 pub mod csf;
 pub mod flip;
+pub mod hdr_flip;
 pub mod mse;
 pub mod pool;
 pub mod ssim;

@@ -489,3 +489,45 @@ fn progress_in_a_log_is_a_line_every_few_seconds_and_quiet_silences_it() {
         .unwrap();
     assert!(!String::from_utf8_lossy(&quiet.stderr).contains(" renders"));
 }
+
+#[test]
+fn diff_on_exr_images_is_hdr_flip_with_the_automatic_exposures() {
+    let o = |f: &str| crate::common::root().join("reference/oracles/hdr").join(f);
+    let (r, t) = (o("room_window_ref.exr"), o("room_window_test.exr"));
+    let run = lodeval(["diff", r.to_str().unwrap(), t.to_str().unwrap(), "--json"]);
+    assert_eq!(run.code, 0, "{}", run.stderr);
+    let v: serde_json::Value = serde_json::from_str(&run.stdout).unwrap();
+    let e = &v[0]["exposures"];
+    assert_eq!(e["count"].as_u64(), Some(11), "{v}");
+    assert!(
+        (v[0]["value"].as_f64().unwrap() - 0.5470386).abs() < 1e-5,
+        "{v}"
+    );
+    // Given exposures are used as given; a range that runs backwards is refused.
+    let run = lodeval([
+        "diff",
+        r.to_str().unwrap(),
+        t.to_str().unwrap(),
+        "--json",
+        "--start-exposure",
+        "-1",
+        "--stop-exposure",
+        "1",
+        "--num-exposures",
+        "2",
+    ]);
+    let v: serde_json::Value = serde_json::from_str(&run.stdout).unwrap();
+    assert_eq!(v[0]["exposures"]["start"].as_f64(), Some(-1.0));
+    let run = lodeval([
+        "diff",
+        r.to_str().unwrap(),
+        t.to_str().unwrap(),
+        "--start-exposure",
+        "1",
+        "--stop-exposure",
+        "-1",
+        "--num-exposures",
+        "2",
+    ]);
+    assert_eq!(run.code, 2, "{}", run.stderr);
+}

@@ -166,3 +166,48 @@ fn psnr_of_the_8_bit_encodings_matches_scikit_image() {
     let a = LinearImage::load(&root().join("reference/oracles/flip/lines_70_ref.png")).unwrap();
     assert_eq!(lodeval::metric::mse::psnr_srgb8(&a, &a).unwrap(), 100.0);
 }
+
+#[test]
+fn hdr_flip_matches_nvidias_flip_evaluator_on_exr_pairs() {
+    // reference/oracles/make_hdr_flip.py: three linear EXR pairs over up to ten stops, HDR-FLIP
+    // with its automatic exposure range. The range must match to the float precision the
+    // reference computes it in, the exposure count exactly, and the mean to 1e-5.
+    use lodeval::metric::{flip::Flip, hdr_flip};
+    let text = std::fs::read_to_string(root().join("reference/oracles/hdr_flip.json")).unwrap();
+    let v: serde_json::Value = serde_json::from_str(&text).unwrap();
+    let cases = v["hdr"].as_array().unwrap();
+    assert!(cases.len() >= 3);
+    for c in cases {
+        let name = c["name"].as_str().unwrap();
+        let load = |k: &str| LinearImage::load(&root().join(c[k].as_str().unwrap())).unwrap();
+        let (r, t) = (load("reference"), load("test"));
+        let e = hdr_flip::exposures_for(&r).unwrap();
+        let (start, stop) = (
+            c["start_exposure"].as_f64().unwrap(),
+            c["stop_exposure"].as_f64().unwrap(),
+        );
+        assert!(
+            (e.start - start).abs() < 1e-5 && (e.stop - stop).abs() < 1e-5,
+            "{name}: {e:?} vs {start} {stop}"
+        );
+        assert_eq!(
+            e.count as u64,
+            c["num_exposures"].as_u64().unwrap(),
+            "{name}"
+        );
+        let flip = Flip::new(c["ppd"].as_f64().unwrap() as f32);
+        let s = hdr_flip::hdr_flip(&flip, &r, &t, None).unwrap();
+        let expected = c["mean_f64"].as_f64().unwrap();
+        eprintln!("{name}: HDR-FLIP {:.7} vs {expected:.7}", s.mean);
+        assert!(
+            (s.mean - expected).abs() < 1e-4,
+            "{name}: {} vs {expected}",
+            s.mean
+        );
+        let max = s.map.values.iter().cloned().fold(0.0f32, f32::max) as f64;
+        assert!(
+            (max - c["max"].as_f64().unwrap()).abs() < 1e-3,
+            "{name}: max {max}"
+        );
+    }
+}
