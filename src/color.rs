@@ -33,6 +33,12 @@ pub fn linear_to_srgb(c: f32) -> f32 {
     }
 }
 
+/// Linear light → the 8-bit sRGB code a PNG stores (clipped to 0..1, rounded): the one encoding
+/// every 8-bit output and the 8-bit PSNR use.
+pub fn linear_to_srgb8(c: f32) -> u8 {
+    (linear_to_srgb(c.clamp(0.0, 1.0)) * 255.0).round() as u8
+}
+
 /// D65 reference white (XYZ, Y = 1), with the digits of NVIDIA's FLIP reference implementation,
 /// whose results lodeval's FLIP reproduces (FLIP's error at nearly identical pixels is sensitive to
 /// the last bit of every constant).

@@ -90,6 +90,17 @@ impl LinearImage {
     pub fn pixels(&self) -> &[Vec3] {
         &self.pixels
     }
+
+    /// The image as 8-bit sRGB, RGB order (values outside 0..1 clipped), as a PNG stores it.
+    pub fn to_srgb8(&self) -> image::RgbImage {
+        let bytes = self
+            .pixels
+            .iter()
+            .flat_map(|c| c.to_array().map(crate::color::linear_to_srgb8))
+            .collect();
+        image::RgbImage::from_raw(self.width as u32, self.height as u32, bytes)
+            .expect("sizes match by construction")
+    }
 }
 
 /// A per-pixel error, row-major, top row first.

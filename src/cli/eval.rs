@@ -26,6 +26,10 @@ pub(crate) struct EvalArgs {
     /// Renderer and FLIP/MSE kernels: cpu, gpu or auto (recorded in the CSVs and the report).
     #[arg(long, value_enum, default_value_t = BackendArg::Cpu)]
     pub(crate) backend: BackendArg,
+    /// Keep the originals' frames in this folder, keyed by a hash of the mesh files, the scene,
+    /// the settings, the camera and this build, and reuse them (same outputs, fewer renders).
+    #[arg(long, value_name = "DIR")]
+    pub(crate) cache: Option<PathBuf>,
 }
 
 /// Run `eval`.
@@ -39,6 +43,7 @@ pub(crate) fn run(a: EvalArgs, quiet: bool) -> Result<(), Error> {
         out: a.out,
         shard,
         backend: a.backend.into(),
+        cache: a.cache,
     };
     let outcome = lodeval::eval::eval(&a.config, &options, &Reporter::new(quiet))?;
     gate_result(&outcome)

@@ -111,6 +111,7 @@ pub fn compare(job: &CompareJob, progress: &dyn Progress) -> Result<CompareRepor
         out: None,
         shard: Shard::ALL,
         backend: job.backend,
+        cache: None,
     };
     let (results, warnings) = evaluate(&plan, &options, progress, None)?;
     let triangles = results

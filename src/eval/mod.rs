@@ -19,6 +19,7 @@
 //! run also writes `shard.json` (the config text, the shard and its cases) so a merge needs
 //! nothing but the folders.
 
+pub mod cache;
 pub mod compare;
 pub mod config;
 pub mod distance;

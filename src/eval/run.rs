@@ -42,6 +42,8 @@ pub struct RunOptions {
     pub shard: Shard,
     /// Where frames are rendered (`--backend`); default the CPU reference.
     pub backend: crate::backend::Backend,
+    /// A render cache for the originals' frames (`--cache`; none by default).
+    pub cache: Option<PathBuf>,
 }
 
 /// A finished (sharded) run.
@@ -118,6 +120,10 @@ pub fn evaluate(
     progress.start(Some(steps as u64), "renders", "");
     let bar = progress;
     let mut export_warnings = Vec::new();
+    let cache = match &options.cache {
+        Some(dir) => Some(super::cache::RenderCache::open(dir)?),
+        None => None,
+    };
     for asset in &plan.assets {
         let wanted: Vec<bool> = asset
             .lods
@@ -152,15 +158,34 @@ pub fn evaluate(
             .collect::<Vec<_>>();
         let cameras = cfg.render.rig.0.cameras(&original, 1.0);
         let reference_renderer = engine.scene(&reference)?;
+        let scene_key = match &cache {
+            Some(c) => Some(c.scene_key(&reference)?),
+            None => None,
+        };
         let lod_renderers = lods
             .iter()
             .map(|l| engine.scene(&l.scene))
             .collect::<Result<Vec<_>>>()?;
         let mut sheets: Vec<SheetViews> = vec![Vec::new(); lods.len()];
         for (v, camera) in cameras.iter().enumerate() {
-            let frame = reference_renderer.render(camera, &settings)?;
-            let ref_thumb = thumbnail(&frame.to_srgb8());
-            let prepared = scorer.prepare(LinearImage::from(&frame));
+            // The original's colour, from the cache where it holds this very frame.
+            let cached = cache
+                .as_ref()
+                .zip(scene_key.as_ref())
+                .and_then(|(c, k)| c.get(k, &settings, camera, &renderer));
+            let reference_image = match cached {
+                Some(px) => LinearImage::new(settings.width as usize, settings.height as usize, px)
+                    .ok_or_else(|| crate::error::Error::Internal("render cache: size".into()))?,
+                None => {
+                    let image = LinearImage::from(&reference_renderer.render(camera, &settings)?);
+                    if let (Some(c), Some(k)) = (&cache, &scene_key) {
+                        c.put(k, &settings, camera, &renderer, image.pixels())?;
+                    }
+                    image
+                }
+            };
+            let ref_thumb = thumbnail(&reference_image.to_srgb8());
+            let prepared = scorer.prepare(reference_image);
             // The LODs of one view are independent: render and score them in parallel, then
             // record them in LOD order (outputs never depend on which finished first).
             let per_lod = lods

@@ -234,6 +234,7 @@ pub fn run(config: &Path, log: &mut dyn FnMut(&str)) -> Result<Report> {
             out: None,
             shard: crate::eval::Shard::ALL,
             backend: crate::backend::Backend::Cpu,
+            cache: None,
         },
         &crate::progress::Silent,
     )?;

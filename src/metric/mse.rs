@@ -83,7 +83,7 @@ pub fn mse(reference: &LinearImage, test: &LinearImage) -> Result<MseScore> {
 /// 10·log10(255² / MSE) in dB, saturating at [`PSNR_CEILING_DB`] for identical encodings.
 pub fn psnr_srgb8(reference: &LinearImage, test: &LinearImage) -> Result<f64> {
     same_size(reference, test)?;
-    let encode = |v: f32| (crate::color::linear_to_srgb(v.clamp(0.0, 1.0)) * 255.0).round() as i32;
+    let encode = |v: f32| i32::from(crate::color::linear_to_srgb8(v));
     let w = reference.width();
     let rows: Vec<f64> = reference
         .pixels()

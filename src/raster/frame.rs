@@ -3,7 +3,7 @@
 
 use glam::Vec3;
 
-use crate::color::linear_to_srgb;
+use crate::color::linear_to_srgb8;
 use crate::error::{Error, Result};
 
 /// Triangle id of a pixel no triangle covers.
@@ -68,10 +68,7 @@ impl Frame {
         let bytes = self
             .color
             .iter()
-            .flat_map(|c| {
-                c.to_array()
-                    .map(|v| (linear_to_srgb(v.clamp(0.0, 1.0)) * 255.0).round() as u8)
-            })
+            .flat_map(|c| c.to_array().map(linear_to_srgb8))
             .collect();
         image::RgbImage::from_raw(self.width, self.height, bytes)
             .expect("sizes match by construction")

@@ -694,3 +694,57 @@ fn the_example_ci_files_set_the_variables_lodeval_reads() {
         completions,
     );
 }
+
+#[test]
+fn the_render_cache_gives_the_same_bytes_and_renders_originals_once() {
+    let dir = tempfile::tempdir().unwrap();
+    let assets = asset("bunny3k", &model("bunny/bunny_odedstein_3k.obj"), CHAIN);
+    let cfg = config(dir.path(), "", &assets);
+    let c = cfg.to_str().unwrap();
+    let out = |name: &str| dir.path().join(name);
+    let cache = dir.path().join("cache");
+    let run = |o: &str, with_cache: bool| {
+        let o = out(o);
+        let mut args = vec!["eval", c, "--out", o.to_str().unwrap()];
+        if with_cache {
+            args.extend(["--cache", cache.to_str().unwrap()]);
+        }
+        let r = lodeval(args);
+        assert_eq!(r.code, 0, "{}", r.stderr);
+    };
+    run("plain", false);
+    run("cold", true);
+    let entries = || files(&cache).len();
+    // One frame per view of the original (12 icosahedron views).
+    assert_eq!(entries(), 12);
+    run("warm", true);
+    assert_eq!(entries(), 12, "a warm run adds nothing");
+    assert_same_tree(&out("plain"), &out("cold"));
+    assert_same_tree(&out("plain"), &out("warm"));
+    // A damaged entry is a miss: rendered again, rewritten, and the outputs stay the same.
+    let first = files(&cache).keys().next().unwrap().clone();
+    std::fs::write(cache.join(&first), b"garbage").unwrap();
+    run("repaired", true);
+    assert_same_tree(&out("plain"), &out("repaired"));
+    assert!(std::fs::metadata(cache.join(&first)).unwrap().len() > 1000);
+    // Another image size is another set of frames.
+    let cfg2 = dir.path().join("c2.toml");
+    std::fs::write(
+        &cfg2,
+        std::fs::read_to_string(&cfg)
+            .unwrap()
+            .replace("size = 64", "size = 48"),
+    )
+    .unwrap();
+    let o = out("other");
+    let r = lodeval([
+        "eval",
+        cfg2.to_str().unwrap(),
+        "--out",
+        o.to_str().unwrap(),
+        "--cache",
+        cache.to_str().unwrap(),
+    ]);
+    assert_eq!(r.code, 0, "{}", r.stderr);
+    assert_eq!(entries(), 24);
+}
