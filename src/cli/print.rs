@@ -39,7 +39,11 @@ pub(crate) fn gate_result(outcome: &lodeval::eval::Outcome) -> Result<(), Error>
         note!("{}", f.message);
     }
     if outcome.failures.is_empty() {
-        emit(&format!("wrote {}\n", outcome.out_dir.display()))
+        emit(&format!(
+            "wrote {}; open {} in a browser\n",
+            outcome.out_dir.display(),
+            outcome.out_dir.join("report.html").display()
+        ))
     } else {
         Err(Error::Regression(format!(
             "{} gate check(s) failed; details in {}",

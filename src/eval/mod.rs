@@ -326,5 +326,11 @@ pub fn summary_table(outcome: &Outcome) -> String {
             if failed { "FAIL" } else { "pass" }
         ));
     }
+    s.push_str(
+        "flip: mean ꟻLIP over views (0 same … 1), flip_max: worst view · psnr_min: worst view, dB \
+         (8-bit sRGB) · vdp_max: detection probability, jnd_max: JND (1 = threshold), worst view · \
+         visible_m / visible_px: imperceptible beyond this distance (metres) / below this on-screen \
+         diameter (pixels) by the VDP, ≥/≤ where the search only bounds it\n",
+    );
     s
 }
