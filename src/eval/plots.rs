@@ -45,7 +45,7 @@ const METRICS: [PlottedMetric; 5] = [
     ),
     (
         "psnr",
-        "PSNR (8-bit sRGB RGB), dB (higher is closer)",
+        "PSNR (8-bit sRGB), dB (higher is closer)",
         &[("psnr_min", "worst view")],
     ),
     (
