@@ -33,9 +33,35 @@ pub fn linear_to_srgb(c: f32) -> f32 {
     }
 }
 
-/// Linear light → the 8-bit sRGB code a PNG stores (clipped to 0..1, rounded): the one encoding
-/// every 8-bit output and the 8-bit PSNR use.
+/// Linear light → the 8-bit sRGB code a PNG stores, round(255 · sRGB(clamp(c, 0, 1))): the one
+/// encoding every 8-bit output and the 8-bit PSNR use. Exact (the same code as the formula for
+/// every input) and without a `powf`: the 255 inputs at which the code steps up are found once by
+/// bisection over the bits of the formula's input, and a code is the number of steps at or below
+/// `c` (a test compares both around every step).
 pub fn linear_to_srgb8(c: f32) -> u8 {
+    static STEPS: std::sync::OnceLock<[f32; 255]> = std::sync::OnceLock::new();
+    let steps = STEPS.get_or_init(|| {
+        let mut out = [0.0f32; 255];
+        for (k, step) in out.iter_mut().enumerate() {
+            // The smallest non-negative float whose code is at least k + 1.
+            let (mut lo, mut hi) = (0u32, 1.0f32.to_bits());
+            while lo < hi {
+                let mid = lo + (hi - lo) / 2;
+                if linear_to_srgb8_formula(f32::from_bits(mid)) as usize > k {
+                    hi = mid;
+                } else {
+                    lo = mid + 1;
+                }
+            }
+            *step = f32::from_bits(lo);
+        }
+        out
+    });
+    steps.partition_point(|&s| s <= c) as u8
+}
+
+/// [`linear_to_srgb8`] by its formula.
+pub fn linear_to_srgb8_formula(c: f32) -> u8 {
     (linear_to_srgb(c.clamp(0.0, 1.0)) * 255.0).round() as u8
 }
 
@@ -187,6 +213,35 @@ pub fn luminance(c: Vec3) -> f32 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_8_bit_encoding_by_steps_equals_the_formula() {
+        // Around every step (±4096 floats) and on a sweep of the whole range, both encodings
+        // agree; out-of-range and NaN inputs clip as the formula does.
+        let check = |v: f32| assert_eq!(linear_to_srgb8(v), linear_to_srgb8_formula(v), "{v}");
+        for k in 0..=255u32 {
+            let v = srgb_to_linear(k as f32 / 255.0);
+            let bits = v.to_bits();
+            for d in 0..8192u32 {
+                check(f32::from_bits((bits + d).saturating_sub(4096)));
+            }
+        }
+        for i in 0..=1_000_000u32 {
+            check(i as f32 / 1_000_000.0);
+        }
+        for v in [
+            -1.0,
+            -0.0,
+            0.0,
+            1.0,
+            1.5,
+            f32::INFINITY,
+            f32::NEG_INFINITY,
+            f32::NAN,
+        ] {
+            check(v);
+        }
+    }
 
     #[test]
     fn colour_spaces_at_known_points() {

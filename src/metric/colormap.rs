@@ -18,8 +18,14 @@ pub fn magma(v: f32) -> [u8; 3] {
 /// from 0 (left) to 1 (right) underneath when `legend > 0`.
 pub fn heat_map(values: &[f32], width: usize, height: usize, legend: usize) -> image::RgbImage {
     let mut img = image::RgbImage::new(width as u32, (height + legend) as u32);
-    for (i, &v) in values.iter().enumerate() {
-        img.put_pixel((i % width) as u32, (i / width) as u32, image::Rgb(magma(v)));
+    let table: Vec<[u8; 3]> = MAGMA
+        .iter()
+        .map(|e| e.map(|c| (c * 255.0 + 0.5) as u8))
+        .collect();
+    for (px, &v) in img.as_mut().chunks_exact_mut(3).zip(values) {
+        // The index exactly as `magma` takes it.
+        let i = ((v.clamp(0.0, 1.0) * 255.0 + 0.5) as usize).min(255);
+        px.copy_from_slice(&table[i]);
     }
     for y in height..height + legend {
         for x in 0..width {
