@@ -405,29 +405,9 @@ fn golden_images_compare_mismatch_bless_and_refuse_under_ci() {
 
 /// The golden report in headless Chromium: the failing row's tint and the images are drawn.
 fn golden_report_renders_in_chromium(report: &Path, dir: &Path) {
-    let Some(browser) = chromium() else {
-        assert!(
-            std::env::var_os("CI").is_none(),
-            "Chromium is required under CI for the report screenshot test"
-        );
-        eprintln!("SKIPPED: no chromium on this machine (apt-get install chromium)");
+    let Some(img) = screenshot(report, &dir.join("golden-shot.png"), (1400, 700)) else {
         return;
     };
-    let shot = dir.join("golden-shot.png");
-    let out = Command::new(&browser)
-        .args([
-            "--headless",
-            "--no-sandbox",
-            "--disable-gpu",
-            "--hide-scrollbars",
-            "--window-size=1400,700",
-            &format!("--screenshot={}", shot.display()),
-        ])
-        .arg(format!("file://{}", report.display()))
-        .output()
-        .unwrap();
-    assert!(shot.exists(), "{}", String::from_utf8_lossy(&out.stderr));
-    let img = image::open(&shot).unwrap().to_rgb8();
     let count = |f: &dyn Fn(&image::Rgb<u8>) -> bool| img.pixels().filter(|p| f(p)).count();
     // The failing row's tint (#fde2e2), its red edge (#c0392b), the painted block in the golden
     // (pure red) and the renders' mid-grey background.
@@ -531,17 +511,36 @@ fn chromium() -> Option<PathBuf> {
         })
 }
 
-#[test]
-fn report_renders_in_headless_chromium_with_its_plot_and_contact_sheets() {
+/// A headless Chromium screenshot of `page` at `size`, or `None` (with a note) where Chromium
+/// is missing outside CI; under CI a missing browser fails the test.
+fn screenshot(page: &Path, shot: &Path, size: (u32, u32)) -> Option<image::RgbImage> {
     let Some(browser) = chromium() else {
         // CI installs Chromium (.ci/run); there a missing browser is a failure, not a skip.
         assert!(
             std::env::var_os("CI").is_none(),
-            "Chromium is required under CI for the report screenshot test"
+            "Chromium is required under CI for the report screenshot tests"
         );
         eprintln!("SKIPPED: no chromium on this machine (apt-get install chromium)");
-        return;
+        return None;
     };
+    let out = Command::new(&browser)
+        .args([
+            "--headless",
+            "--no-sandbox",
+            "--disable-gpu",
+            "--hide-scrollbars",
+            &format!("--window-size={},{}", size.0, size.1),
+            &format!("--screenshot={}", shot.display()),
+        ])
+        .arg(format!("file://{}", page.display()))
+        .output()
+        .unwrap();
+    assert!(shot.exists(), "{}", String::from_utf8_lossy(&out.stderr));
+    Some(image::open(shot).unwrap().to_rgb8())
+}
+
+#[test]
+fn report_renders_in_headless_chromium_with_its_plot_and_contact_sheets() {
     let dir = tempfile::tempdir().unwrap();
     let assets = asset(
         "spot",
@@ -552,21 +551,9 @@ fn report_renders_in_headless_chromium_with_its_plot_and_contact_sheets() {
     let r = lodeval(["eval", cfg.to_str().unwrap()]);
     assert_eq!(r.code, 1, "the 10 % LOD fails the gate: {}", r.stderr);
     let report = dir.path().join("out/report.html");
-    let shot = dir.path().join("shot.png");
-    let out = Command::new(&browser)
-        .args([
-            "--headless",
-            "--no-sandbox",
-            "--disable-gpu",
-            "--hide-scrollbars",
-            "--window-size=1200,1600",
-            &format!("--screenshot={}", shot.display()),
-        ])
-        .arg(format!("file://{}", report.display()))
-        .output()
-        .unwrap();
-    assert!(shot.exists(), "{}", String::from_utf8_lossy(&out.stderr));
-    let img = image::open(&shot).unwrap().to_rgb8();
+    let Some(img) = screenshot(&report, &dir.path().join("shot.png"), (1200, 1600)) else {
+        return;
+    };
     assert_eq!(img.dimensions(), (1200, 1600));
     let count = |f: &dyn Fn(&image::Rgb<u8>) -> bool| img.pixels().filter(|p| f(p)).count();
     // The plot line (#b5367a), the failing row's tint (#fde2e2) and the renders' mid-grey
