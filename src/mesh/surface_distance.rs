@@ -309,10 +309,24 @@ pub fn samples(mesh: &Mesh, face_samples: usize) -> Vec<Vec3> {
 
 /// One direction: distances from `samples` to the surface.
 fn one_sided(samples: &[Vec3], to: &ClosestPoint) -> (f64, f64, f64) {
+    // Samples come triangle by triangle, so the previous sample's nearest triangle is a close
+    // hint for the next (the distance does not depend on the hint, only the search's length).
     let d: Vec<f32> = samples
-        .par_iter()
-        .with_min_len(1024)
-        .map(|&q| to.distance(q))
+        .par_chunks(1024)
+        .flat_map_iter(|chunk| {
+            let mut hint = None;
+            chunk
+                .iter()
+                .map(|&q| {
+                    let found = match hint {
+                        Some(h) => to.closest_from(q, h),
+                        None => to.closest(q),
+                    };
+                    hint = found.map(|f| f.0);
+                    found.map_or(f32::INFINITY, |f| f.1)
+                })
+                .collect::<Vec<_>>()
+        })
         .collect();
     let max = d.iter().copied().fold(0.0f32, f32::max) as f64;
     // Sums in index order (deterministic for any thread count).
