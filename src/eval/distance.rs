@@ -35,16 +35,18 @@
 //! the VDP is not guaranteed monotone in size, so the bisection finds *a* crossing, the nearest to
 //! the largest size where the LOD was first seen.
 
-use std::collections::BTreeMap;
+use std::collections::{BTreeMap, HashMap};
+use std::sync::{Arc, Mutex};
 
 use glam::Vec3;
+use rayon::prelude::*;
 
 use super::config::{DistanceConfig, SampleCount, ViewingConfig};
 use super::tables::{DistanceBound, DistanceRow, round7};
 use crate::error::Result;
 use crate::image::LinearImage;
-use crate::metric::flip::Flip;
-use crate::metric::vdp::Vdp;
+use crate::metric::flip::{Flip, FlipPrepared};
+use crate::metric::vdp::{Vdp, VdpPrepared};
 use crate::raster::{self, RenderScene, RenderSettings, SamplePattern};
 use crate::scene::{Camera, Projection};
 
@@ -117,6 +119,54 @@ pub struct DistanceJob<'a> {
     /// The engine's switch distance for this LOD, metres, if the gate checks one: the search
     /// then also covers the on-screen size at that distance, so the gate gets an answer there.
     pub switch_m: Option<f64>,
+    /// The original's probe renders, shared by the searches of every LOD of one asset (they
+    /// probe the same diameters from mostly the same views); `None`: this search's own.
+    pub originals: Option<&'a OriginalProbes>,
+}
+
+/// The original's side of each probe — its render at one diameter from one direction, prepared
+/// for the VDP (and FLIP) — kept for the searches of all LODs of one asset, which run in
+/// parallel. Valid for one original scene, one viewing condition and one set of render settings.
+/// Entries are pure functions of their key, so which search computes one first does not change
+/// any result.
+#[derive(Debug, Default)]
+pub struct OriginalProbes {
+    entries: Mutex<HashMap<ProbeKey, Arc<PreparedOriginal>>>,
+}
+
+/// (diameter in pixels' bits, view direction's bits, samples per side, with FLIP).
+type ProbeKey = (u64, [u32; 3], u32, bool);
+
+#[derive(Debug)]
+struct PreparedOriginal {
+    vdp: VdpPrepared,
+    flip: Option<FlipPrepared>,
+}
+
+impl OriginalProbes {
+    /// An empty cache.
+    pub fn new() -> OriginalProbes {
+        OriginalProbes::default()
+    }
+
+    fn get_or_make(
+        &self,
+        key: ProbeKey,
+        make: impl FnOnce() -> Result<PreparedOriginal>,
+    ) -> Result<Arc<PreparedOriginal>> {
+        if let Some(p) = self.lock().get(&key) {
+            return Ok(p.clone());
+        }
+        // Made outside the lock: two searches may make the same entry at once (the same
+        // values), and the first one stored is kept.
+        let made = Arc::new(make()?);
+        Ok(self.lock().entry(key).or_insert(made).clone())
+    }
+
+    fn lock(&self) -> std::sync::MutexGuard<'_, HashMap<ProbeKey, Arc<PreparedOriginal>>> {
+        // A poisoned lock only means another search panicked; the map itself is consistent.
+        self.entries.lock().unwrap_or_else(|e| e.into_inner())
+    }
 }
 
 /// Renders the original and the LOD as the display's viewer sees them at a given on-screen size
@@ -125,7 +175,8 @@ struct Prober<'a> {
     job: &'a DistanceJob<'a>,
     display: Screen,
     vdp: Vdp,
-    flip: Flip,
+    /// FLIP, where a criterion or the caller needs it.
+    flip: Option<Flip>,
     sphere: crate::mesh::Sphere,
     settings: RenderSettings,
     side: u32,
@@ -137,54 +188,86 @@ impl<'a> Prober<'a> {
         viewing: &ViewingConfig,
         settings: &RenderSettings,
         side: u32,
+        with_flip: bool,
     ) -> Prober<'a> {
         let view = viewing.viewing();
         Prober {
             job,
             display: Screen::new(viewing),
             vdp: Vdp::new(&view, viewing.display()),
-            flip: Flip::new(view.ppd() as f32),
+            flip: with_flip.then(|| Flip::new(view.ppd() as f32)),
             sphere: job.original.mesh().bounding_sphere(),
             settings: *settings,
             side,
         }
     }
 
-    /// The worst view's scores with the bounding sphere `diameter` display pixels across.
-    fn at(&self, diameter: f64) -> Result<Probe> {
+    /// Worst over the views at on-screen diameter `diameter` (pixels); `originals` holds (and
+    /// receives) the original's prepared renders. Views run in parallel; the worst is a maximum,
+    /// the same in any order.
+    fn at(&self, diameter: f64, originals: &OriginalProbes) -> Result<Probe> {
         let (display, sphere) = (&self.display, self.sphere);
         let r_units = sphere.radius as f64;
         let d_units = display.distance_for(r_units, diameter);
+        // A square crop around the disc with a 10 % + 4 px border on each side.
         let size = (diameter * 1.1).ceil() as u32 + 8;
         let mut s = self.settings;
         s.width = size;
         s.height = size;
         s.samples = SamplePattern::Rotated(self.side);
-        // Vertical field of view of `size` display pixels.
+        // The crop's field of view at the display's pixel scale.
         let fov = 2.0 * ((size as f64 / 2.0) / display.k).atan();
-        let mut worst = Probe {
-            vdp: 0.0,
-            vdp_jnd: 0.0,
-            flip: 0.0,
-        };
-        for &dir in &self.job.directions {
-            let mut cam = Camera::frame_sphere(sphere, dir, 30.0, 1.0, 0.0);
-            let dir = cam.to_eye();
-            cam.eye = sphere.center + dir * d_units as f32;
-            cam.projection = Projection::Perspective {
-                fov_y_deg: fov.to_degrees() as f32,
-            };
-            cam.near = ((d_units - r_units * 1.01) as f32).max(d_units as f32 * 1e-4);
-            cam.far = (d_units + r_units * 1.01) as f32;
-            let a = LinearImage::from(&raster::render(self.job.original, &cam, &s)?);
-            let b = LinearImage::from(&raster::render(self.job.lod, &cam, &s)?);
-            let v = self.vdp.compare(&a, &b)?;
-            let f = self.flip.compare(&a, &b)?.mean;
-            worst.vdp = worst.vdp.max(v.probability);
-            worst.vdp_jnd = worst.vdp_jnd.max(v.jnd);
-            worst.flip = worst.flip.max(f);
-        }
-        Ok(worst)
+        let per_view = self
+            .job
+            .directions
+            .par_iter()
+            .map(|&dir| -> Result<Probe> {
+                let mut cam = Camera::frame_sphere(sphere, dir, 30.0, 1.0, 0.0);
+                let dir = cam.to_eye();
+                cam.eye = sphere.center + dir * d_units as f32;
+                cam.projection = Projection::Perspective {
+                    fov_y_deg: fov.to_degrees() as f32,
+                };
+                cam.near = ((d_units - r_units * 1.01) as f32).max(d_units as f32 * 1e-4);
+                cam.far = (d_units + r_units * 1.01) as f32;
+                let key = (
+                    diameter.to_bits(),
+                    dir.to_array().map(f32::to_bits),
+                    self.side,
+                    self.flip.is_some(),
+                );
+                let a = originals.get_or_make(key, || {
+                    let a = LinearImage::from(&raster::render(self.job.original, &cam, &s)?);
+                    Ok(PreparedOriginal {
+                        vdp: self.vdp.prepare(&a),
+                        flip: self.flip.as_ref().map(|f| f.prepare(&a)),
+                    })
+                })?;
+                let b = LinearImage::from(&raster::render(self.job.lod, &cam, &s)?);
+                let v = self.vdp.compare_prepared(&a.vdp, &self.vdp.prepare(&b))?;
+                let f = match (&self.flip, &a.flip) {
+                    (Some(flip), Some(fa)) => flip.compare_prepared(fa, &flip.prepare(&b))?.mean,
+                    _ => 0.0,
+                };
+                Ok(Probe {
+                    vdp: v.probability,
+                    vdp_jnd: v.jnd,
+                    flip: f,
+                })
+            })
+            .collect::<Result<Vec<_>>>()?;
+        Ok(per_view.iter().fold(
+            Probe {
+                vdp: 0.0,
+                vdp_jnd: 0.0,
+                flip: 0.0,
+            },
+            |w, p| Probe {
+                vdp: w.vdp.max(p.vdp),
+                vdp_jnd: w.vdp_jnd.max(p.vdp_jnd),
+                flip: w.flip.max(p.flip),
+            },
+        ))
     }
 }
 
@@ -199,13 +282,14 @@ pub fn visibility_at(
     samples: SampleCount,
     distance_m: f64,
 ) -> Result<(f64, f64, f64)> {
-    let prober = Prober::new(job, viewing, settings, samples.side());
+    let prober = Prober::new(job, viewing, settings, samples.side(), true);
     let r_m = prober.sphere.radius as f64 * job.meters_per_unit;
     let diameter = prober
         .display
         .diameter_px(r_m, distance_m.max(r_m * 1.0001))
         .min(crate::limits::IMAGE_SIDE.max as f64 / 1.1 - 16.0);
-    let p = prober.at(diameter)?;
+    let own = OriginalProbes::new();
+    let p = prober.at(diameter, job.originals.unwrap_or(&own))?;
     Ok((p.vdp, p.vdp_jnd, p.flip))
 }
 
@@ -228,14 +312,22 @@ pub fn search(
     settings: &RenderSettings,
 ) -> Result<Vec<DistanceRow>> {
     let display = Screen::new(viewing);
-    let prober = Prober::new(job, viewing, settings, config.samples.side());
+    let prober = Prober::new(
+        job,
+        viewing,
+        settings,
+        config.samples.side(),
+        config.flip_mean.is_some(),
+    );
+    let own = OriginalProbes::new();
+    let originals = job.originals.unwrap_or(&own);
     let r_units = prober.sphere.radius as f64;
     let mut probes: BTreeMap<u32, Probe> = BTreeMap::new();
     let mut probe = |diameter: u32| -> Result<Probe> {
         if let Some(p) = probes.get(&diameter) {
             return Ok(*p);
         }
-        let worst = prober.at(diameter as f64)?;
+        let worst = prober.at(diameter as f64, originals)?;
         probes.insert(diameter, worst);
         Ok(worst)
     };

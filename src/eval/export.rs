@@ -101,6 +101,7 @@ pub fn measure(
     let directions: Vec<glam::Vec3> = cameras.iter().take(3).map(|c| c.to_eye()).collect();
     let settings = cfg.render.settings();
     let mut rows = Vec::new();
+    let originals = super::distance::OriginalProbes::new();
     for (name, lod) in lods {
         let scene = super::run::scene_for(&cfg, lod.clone());
         let job = super::distance::DistanceJob {
@@ -111,6 +112,7 @@ pub fn measure(
             simplifier_error: None,
             names: (ORIGINAL, name, lod.triangle_count()),
             switch_m: None,
+            originals: Some(&originals),
         };
         rows.extend(super::distance::search(
             &job,

@@ -274,31 +274,37 @@ pub fn evaluate(
                     &image::DynamicImage::ImageRgb8(sheet),
                 )?;
             }
-            if cfg.distance.enabled {
-                bar.set_message(&format!("{} {} distance", asset.name, lod.name));
-                let take = cfg.distance.views.unwrap_or(3).max(1);
-                let directions = order
-                    .iter()
-                    .take(take)
-                    .map(|&v| cameras[v].to_eye())
-                    .collect();
-                let job = DistanceJob {
-                    original: &reference,
-                    lod: &lod.scene,
-                    directions,
-                    meters_per_unit: asset.meters_per_unit,
-                    simplifier_error: lod.info.simplifier_error,
-                    names: (&asset.name, &lod.name, lod.info.triangles),
-                    switch_m: lod.info.switch_m,
-                };
-                results.distances.extend(distance::search(
-                    &job,
-                    &cfg.distance,
-                    &cfg.viewing,
-                    &settings,
-                )?);
-                bar.advance(1);
-            }
+        }
+        if cfg.distance.enabled {
+            // The LODs' searches in parallel, sharing the original's probe renders; rows in LOD
+            // order.
+            bar.set_message(&format!("{} distances", asset.name));
+            let originals = distance::OriginalProbes::new();
+            let take = cfg.distance.views.unwrap_or(3).max(1);
+            let rows = lods
+                .par_iter()
+                .map(|lod| {
+                    let order = worst_first(&results, &asset.name, &lod.name, &cfg.metrics);
+                    let job = DistanceJob {
+                        original: &reference,
+                        lod: &lod.scene,
+                        directions: order
+                            .iter()
+                            .take(take)
+                            .map(|&v| cameras[v].to_eye())
+                            .collect(),
+                        meters_per_unit: asset.meters_per_unit,
+                        simplifier_error: lod.info.simplifier_error,
+                        names: (&asset.name, &lod.name, lod.info.triangles),
+                        switch_m: lod.info.switch_m,
+                        originals: Some(&originals),
+                    };
+                    let rows = distance::search(&job, &cfg.distance, &cfg.viewing, &settings);
+                    bar.advance(1);
+                    rows
+                })
+                .collect::<Result<Vec<_>>>()?;
+            results.distances.extend(rows.into_iter().flatten());
         }
         let ext = match cfg.export.gltf {
             GltfExport::None => None,

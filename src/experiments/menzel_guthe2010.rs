@@ -243,6 +243,7 @@ fn job<'a>(
         simplifier_error: None,
         names: ("", "", 0),
         switch_m: None,
+        originals: None,
     }
 }
 
