@@ -37,12 +37,19 @@ pub fn linear_to_srgb(c: f32) -> f32 {
 /// encoding every 8-bit output and the 8-bit PSNR use. Exact (the same code as the formula for
 /// every input) and without a `powf`: the 255 inputs at which the code steps up are found once by
 /// bisection over the bits of the formula's input, and a code is the number of steps at or below
-/// `c` (a test compares both around every step).
+/// `c` (a test compares both around every step). The count starts from a table of the code at
+/// the start of each 1/128 of an octave of `c` (the top 16 bits of its `f32`), within which the
+/// code rises by at most two steps.
 pub fn linear_to_srgb8(c: f32) -> u8 {
-    static STEPS: std::sync::OnceLock<[f32; 255]> = std::sync::OnceLock::new();
-    let steps = STEPS.get_or_init(|| {
-        let mut out = [0.0f32; 255];
-        for (k, step) in out.iter_mut().enumerate() {
+    const SHIFT: u32 = 16;
+    struct Tables {
+        steps: [f32; 255],
+        start: Vec<u8>,
+    }
+    static TABLES: std::sync::OnceLock<Tables> = std::sync::OnceLock::new();
+    let t = TABLES.get_or_init(|| {
+        let mut steps = [0.0f32; 255];
+        for (k, step) in steps.iter_mut().enumerate() {
             // The smallest non-negative float whose code is at least k + 1.
             let (mut lo, mut hi) = (0u32, 1.0f32.to_bits());
             while lo < hi {
@@ -55,9 +62,26 @@ pub fn linear_to_srgb8(c: f32) -> u8 {
             }
             *step = f32::from_bits(lo);
         }
-        out
+        let start = (0..=(1.0f32.to_bits() >> SHIFT))
+            .map(|b| {
+                let first = f32::from_bits(b << SHIFT);
+                steps.partition_point(|&s| s <= first) as u8
+            })
+            .collect();
+        Tables { steps, start }
     });
-    steps.partition_point(|&s| s <= c) as u8
+    // NaN and everything at or below zero encode as 0, everything at or above one as 255.
+    if !(c > 0.0) {
+        return 0;
+    }
+    if c >= 1.0 {
+        return 255;
+    }
+    let mut k = t.start[(c.to_bits() >> SHIFT) as usize] as usize;
+    while k < 255 && t.steps[k] <= c {
+        k += 1;
+    }
+    k as u8
 }
 
 /// [`linear_to_srgb8`] by its formula.

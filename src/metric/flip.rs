@@ -139,29 +139,68 @@ fn feature_filter(ppd: f32) -> Vec<[f32; 3]> {
     taps
 }
 
-/// Horizontal then vertical pass of a separable filter with clamped borders. `pass_x` maps a row
-/// of source values to filtered ones (`K` channels); `pass_y` likewise per column, fed the
-/// horizontal results. Both run over rows in parallel.
-fn separable<S: Sync, I: Send + Sync + Copy + Default, O: Send + Copy + Default>(
+/// One output plane of a separable pass: the input plane it reads and its taps, in order.
+type Pass<'a> = (usize, &'a [f32]);
+
+/// The horizontal pass of a separable filter with clamped borders: for each of `passes`,
+/// out[x] = Σ_k taps[k] · in[clamp(x + k − r)], summed in tap order (the order the reference
+/// implementation sums in). Returns the rows of every output plane interleaved: row y of pass p
+/// at `(y · passes.len() + p) · width`. Rows run in parallel; each tap is one vectorised sweep
+/// over a border-padded copy of the row.
+fn filter_rows(width: usize, height: usize, planes: &[Vec<f32>], passes: &[Pass]) -> Vec<f32> {
+    let n = passes.len();
+    let mut out = vec![0.0f32; width * height * n];
+    out.par_chunks_mut(width * n)
+        .enumerate()
+        .for_each_init(Vec::new, |pad: &mut Vec<f32>, (y, rows)| {
+            for ((plane, taps), o) in passes.iter().zip(rows.chunks_exact_mut(width)) {
+                let r = taps.len() / 2;
+                let row = &planes[*plane][y * width..(y + 1) * width];
+                pad.clear();
+                pad.extend(
+                    (0..width + 2 * r).map(|i| row[clamp_index(i as isize - r as isize, width)]),
+                );
+                for (k, &t) in taps.iter().enumerate() {
+                    for (o, &v) in o.iter_mut().zip(&pad[k..k + width]) {
+                        *o += t * v;
+                    }
+                }
+            }
+        });
+    out
+}
+
+/// The vertical pass over [`filter_rows`]' output (`planes_in` planes interleaved by row): for
+/// each of `passes` the column sums with clamped borders, in tap order, then `finish` turns the
+/// sums at column x (pass p's at `sums[p · width + x]`) into one output pixel. Rows in parallel.
+fn filter_columns<O: Send + Copy + Default>(
     width: usize,
     height: usize,
-    src: &[S],
-    pass_x: impl Fn(&[S], usize) -> I + Sync,
-    pass_y: impl Fn(&[I], usize, usize) -> O + Sync,
+    mid: &[f32],
+    planes_in: usize,
+    passes: &[Pass],
+    finish: impl Fn(&[f32], usize) -> O + Sync,
 ) -> Vec<O> {
-    let mut mid = vec![I::default(); width * height];
-    mid.par_chunks_mut(width).enumerate().for_each(|(y, row)| {
-        let src_row = &src[y * width..(y + 1) * width];
-        for (x, out) in row.iter_mut().enumerate() {
-            *out = pass_x(src_row, x);
-        }
-    });
     let mut out = vec![O::default(); width * height];
-    out.par_chunks_mut(width).enumerate().for_each(|(y, row)| {
-        for (x, o) in row.iter_mut().enumerate() {
-            *o = pass_y(&mid, x, y);
-        }
-    });
+    out.par_chunks_mut(width).enumerate().for_each_init(
+        || vec![0.0f32; width * passes.len()],
+        |sums: &mut Vec<f32>, (y, row)| {
+            sums.fill(0.0);
+            for ((plane, taps), s) in passes.iter().zip(sums.chunks_exact_mut(width)) {
+                let r = taps.len() / 2;
+                for (k, &t) in taps.iter().enumerate() {
+                    let src = clamp_index(y as isize + k as isize - r as isize, height);
+                    let start = (src * planes_in + plane) * width;
+                    for (s, &v) in s.iter_mut().zip(&mid[start..start + width]) {
+                        *s += t * v;
+                    }
+                }
+            }
+            for (x, o) in row.iter_mut().enumerate() {
+                *o = finish(sums, x);
+            }
+        },
+    );
     out
 }
 
@@ -241,66 +280,47 @@ impl Flip {
             .par_iter()
             .map(|&c| xyz_to_ycxcz(rgb_to_xyz(c)))
             .collect();
-        let r = (self.spatial.len() / 2) as isize;
-        // Colour: CSF filtering in YCxCz, back to linear RGB (clamped), CIELAB, Hunt.
-        let lab = separable(
+        let planes: Vec<Vec<f32>> = (0..3)
+            .map(|c| ycxcz.iter().map(|v| v[c]).collect())
+            .collect();
+        // Colour: CSF filtering in YCxCz (Y, Cx, and Cz as the sum of two Gaussians), back to
+        // linear RGB (clamped), CIELAB, Hunt.
+        let tap = |f: fn(&([f32; 2], [f32; 2])) -> f32| self.spatial.iter().map(f).collect();
+        let (y, cx, cz1, cz2): (Vec<f32>, Vec<f32>, Vec<f32>, Vec<f32>) =
+            (tap(|t| t.0[0]), tap(|t| t.0[1]), tap(|t| t.1[0]), tap(|t| t.1[1]));
+        let mid = filter_rows(w, h, &planes, &[(0, &y), (1, &cx), (2, &cz1), (2, &cz2)]);
+        let lab = filter_columns(
             w,
             h,
-            &ycxcz,
-            |row: &[Vec3], x| {
-                let mut acc = [0.0f32; 4];
-                for (k, (ycx, cz)) in self.spatial.iter().enumerate() {
-                    let c = row[clamp_index(x as isize + k as isize - r, w)];
-                    acc[0] += ycx[0] * c.x;
-                    acc[1] += ycx[1] * c.y;
-                    acc[2] += cz[0] * c.z;
-                    acc[3] += cz[1] * c.z;
-                }
-                acc
-            },
-            |mid: &[[f32; 4]], x, y| {
-                let mut acc = [0.0f32; 4];
-                for (k, (ycx, cz)) in self.spatial.iter().enumerate() {
-                    let m = mid[clamp_index(y as isize + k as isize - r, h) * w + x];
-                    acc[0] += ycx[0] * m[0];
-                    acc[1] += ycx[1] * m[1];
-                    acc[2] += cz[0] * m[2];
-                    acc[3] += cz[1] * m[3];
-                }
-                let filtered = Vec3::new(acc[0], acc[1], acc[2] + acc[3]);
+            &mid,
+            4,
+            &[(0, &y), (1, &cx), (2, &cz1), (3, &cz2)],
+            |s, x| {
+                let filtered = Vec3::new(s[x], s[w + x], s[2 * w + x] + s[3 * w + x]);
                 let rgb = xyz_to_rgb(ycxcz_to_xyz(filtered)).clamp(Vec3::ZERO, Vec3::ONE);
                 hunt(xyz_to_lab(rgb_to_xyz(rgb)))
             },
         );
         // Features: edges and points on the normalised achromatic channel.
-        let gray: Vec<f32> = ycxcz
-            .iter()
-            .map(|c| c.x * (1.0 / 116.0) + 16.0 / 116.0)
-            .collect();
-        let r = (self.features.len() / 2) as isize;
-        let features = separable(
+        let gray = vec![
+            ycxcz
+                .iter()
+                .map(|c| c.x * (1.0 / 116.0) + 16.0 / 116.0)
+                .collect(),
+        ];
+        let tap = |i: usize| -> Vec<f32> { self.features.iter().map(|f| f[i]).collect() };
+        let (g, dg, ddg) = (tap(0), tap(1), tap(2));
+        // Rows: d/dx, d²/dx², Gaussian; columns: their Gaussian (x derivatives) and the y
+        // derivatives of the Gaussian row.
+        let mid = filter_rows(w, h, &gray, &[(0, &dg), (0, &ddg), (0, &g)]);
+        let features = filter_columns(
             w,
             h,
-            &gray,
-            |row: &[f32], x| {
-                let mut acc = [0.0f32; 3]; // d/dx, d²/dx², Gaussian
-                for (k, f) in self.features.iter().enumerate() {
-                    let v = row[clamp_index(x as isize + k as isize - r, w)];
-                    acc[0] += f[1] * v;
-                    acc[1] += f[2] * v;
-                    acc[2] += f[0] * v;
-                }
-                acc
-            },
-            |mid: &[[f32; 3]], x, y| {
-                let (mut dx, mut ddx, mut dy, mut ddy) = (0.0f32, 0.0f32, 0.0f32, 0.0f32);
-                for (k, f) in self.features.iter().enumerate() {
-                    let m = mid[clamp_index(y as isize + k as isize - r, h) * w + x];
-                    dx += f[0] * m[0];
-                    ddx += f[0] * m[1];
-                    dy += f[1] * m[2];
-                    ddy += f[2] * m[2];
-                }
+            &mid,
+            3,
+            &[(0, &g), (1, &g), (2, &dg), (2, &ddg)],
+            |s, x| {
+                let (dx, ddx, dy, ddy) = (s[x], s[w + x], s[2 * w + x], s[3 * w + x]);
                 [(dx * dx + dy * dy).sqrt(), (ddx * ddx + ddy * ddy).sqrt()]
             },
         );

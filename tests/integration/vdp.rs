@@ -462,6 +462,7 @@ fn half_the_triangles_of_a_dense_scan_is_invisible_at_a_hundred_and_fifty_pixels
         simplifier_error: None,
         names: ("bunny", "meshopt-r50", 0),
         switch_m: None,
+        originals: None,
     };
     let config = DistanceConfig {
         flip_mean: None,
