@@ -150,9 +150,9 @@ type Pass<'a> = (usize, &'a [f32]);
 fn filter_rows(width: usize, height: usize, planes: &[Vec<f32>], passes: &[Pass]) -> Vec<f32> {
     let n = passes.len();
     let mut out = vec![0.0f32; width * height * n];
-    out.par_chunks_mut(width * n)
-        .enumerate()
-        .for_each_init(Vec::new, |pad: &mut Vec<f32>, (y, rows)| {
+    out.par_chunks_mut(width * n).enumerate().for_each_init(
+        Vec::new,
+        |pad: &mut Vec<f32>, (y, rows)| {
             for ((plane, taps), o) in passes.iter().zip(rows.chunks_exact_mut(width)) {
                 let r = taps.len() / 2;
                 let row = &planes[*plane][y * width..(y + 1) * width];
@@ -166,20 +166,22 @@ fn filter_rows(width: usize, height: usize, planes: &[Vec<f32>], passes: &[Pass]
                     }
                 }
             }
-        });
+        },
+    );
     out
 }
 
 /// The vertical pass over [`filter_rows`]' output (`planes_in` planes interleaved by row): for
 /// each of `passes` the column sums with clamped borders, in tap order, then `finish` turns the
-/// sums at column x (pass p's at `sums[p · width + x]`) into one output pixel. Rows in parallel.
+/// row's sums (pass p's at column x in `sums[p · width + x]`) into the row's output pixels. Rows
+/// in parallel.
 fn filter_columns<O: Send + Copy + Default>(
     width: usize,
     height: usize,
     mid: &[f32],
     planes_in: usize,
     passes: &[Pass],
-    finish: impl Fn(&[f32], usize) -> O + Sync,
+    finish: impl Fn(&[f32], &mut [O]) + Sync,
 ) -> Vec<O> {
     let mut out = vec![O::default(); width * height];
     out.par_chunks_mut(width).enumerate().for_each_init(
@@ -196,9 +198,7 @@ fn filter_columns<O: Send + Copy + Default>(
                     }
                 }
             }
-            for (x, o) in row.iter_mut().enumerate() {
-                *o = finish(sums, x);
-            }
+            finish(sums, row);
         },
     );
     out
@@ -286,8 +286,12 @@ impl Flip {
         // Colour: CSF filtering in YCxCz (Y, Cx, and Cz as the sum of two Gaussians), back to
         // linear RGB (clamped), CIELAB, Hunt.
         let tap = |f: fn(&([f32; 2], [f32; 2])) -> f32| self.spatial.iter().map(f).collect();
-        let (y, cx, cz1, cz2): (Vec<f32>, Vec<f32>, Vec<f32>, Vec<f32>) =
-            (tap(|t| t.0[0]), tap(|t| t.0[1]), tap(|t| t.1[0]), tap(|t| t.1[1]));
+        let (y, cx, cz1, cz2): (Vec<f32>, Vec<f32>, Vec<f32>, Vec<f32>) = (
+            tap(|t| t.0[0]),
+            tap(|t| t.0[1]),
+            tap(|t| t.1[0]),
+            tap(|t| t.1[1]),
+        );
         let mid = filter_rows(w, h, &planes, &[(0, &y), (1, &cx), (2, &cz1), (2, &cz2)]);
         let lab = filter_columns(
             w,
@@ -295,10 +299,22 @@ impl Flip {
             &mid,
             4,
             &[(0, &y), (1, &cx), (2, &cz1), (3, &cz2)],
-            |s, x| {
-                let filtered = Vec3::new(s[x], s[w + x], s[2 * w + x] + s[3 * w + x]);
-                let rgb = xyz_to_rgb(ycxcz_to_xyz(filtered)).clamp(Vec3::ZERO, Vec3::ONE);
-                hunt(xyz_to_lab(rgb_to_xyz(rgb)))
+            |s, row| {
+                // Runs of equal filtered values (a flat background) convert once.
+                let mut last: Option<(Vec3, Vec3)> = None;
+                for (x, o) in row.iter_mut().enumerate() {
+                    let filtered = Vec3::new(s[x], s[w + x], s[2 * w + x] + s[3 * w + x]);
+                    *o = match last {
+                        Some((f, lab)) if f == filtered => lab,
+                        _ => {
+                            let rgb =
+                                xyz_to_rgb(ycxcz_to_xyz(filtered)).clamp(Vec3::ZERO, Vec3::ONE);
+                            let lab = hunt(xyz_to_lab(rgb_to_xyz(rgb)));
+                            last = Some((filtered, lab));
+                            lab
+                        }
+                    };
+                }
             },
         );
         // Features: edges and points on the normalised achromatic channel.
@@ -319,9 +335,11 @@ impl Flip {
             &mid,
             3,
             &[(0, &g), (1, &g), (2, &dg), (2, &ddg)],
-            |s, x| {
-                let (dx, ddx, dy, ddy) = (s[x], s[w + x], s[2 * w + x], s[3 * w + x]);
-                [(dx * dx + dy * dy).sqrt(), (ddx * ddx + ddy * ddy).sqrt()]
+            |s, row| {
+                for (x, o) in row.iter_mut().enumerate() {
+                    let (dx, ddx, dy, ddy) = (s[x], s[w + x], s[2 * w + x], s[3 * w + x]);
+                    *o = [(dx * dx + dy * dy).sqrt(), (ddx * ddx + ddy * ddy).sqrt()];
+                }
             },
         );
         FlipPrepared {
@@ -349,6 +367,10 @@ impl Flip {
             .into_par_iter()
             .with_min_len(4096)
             .map(|i| {
+                // Equal colour and features: no error (what the formulas below give, exactly).
+                if reference.lab[i] == test.lab[i] && reference.features[i] == test.features[i] {
+                    return 0.0;
+                }
                 // Colour difference, remapped to [0, 1] with the knee at pc·cmax (paper §3.2).
                 let mut dc = hyab(reference.lab[i], test.lab[i]).powf(QC);
                 dc = if dc < pccmax {

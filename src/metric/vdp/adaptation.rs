@@ -61,10 +61,27 @@ impl BandAdaptation {
     pub(crate) fn apply(&self, band: &mut Plane, adapt: &Plane) {
         use rayon::prelude::*;
         let (w, aw, ah) = (band.w, adapt.w, adapt.h);
+        // The gain of every coarse sample once (each serves up to four band samples); a run of
+        // equal luminances (a flat background) takes one logarithm.
+        let gains: Vec<f32> = adapt
+            .v
+            .par_chunks(aw)
+            .flat_map_iter(|row| {
+                let mut last = None;
+                row.iter().map(move |&l| match last {
+                    Some((m, g)) if m == l => g,
+                    _ => {
+                        let g = self.gain(l);
+                        last = Some((l, g));
+                        g
+                    }
+                })
+            })
+            .collect();
         band.v.par_chunks_mut(w).enumerate().for_each(|(y, row)| {
-            let arow = &adapt.v[(y / 2).min(ah - 1) * aw..][..aw];
+            let grow = &gains[(y / 2).min(ah - 1) * aw..][..aw];
             for (x, v) in row.iter_mut().enumerate() {
-                *v *= self.gain(arow[(x / 2).min(aw - 1)]);
+                *v *= grow[(x / 2).min(aw - 1)];
             }
         });
     }

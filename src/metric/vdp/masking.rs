@@ -21,8 +21,18 @@ const B: f32 = 4.0;
 
 /// Threshold elevation for a masker of `m` JND (≥ 1; 1 means no masking).
 pub fn threshold_elevation(m: f32) -> f32 {
-    (1.0 + m.abs().powf(SLOPE * B)).powf(1.0 / B)
+    let m = m.abs();
+    // At or below this masker m^(s·b) < 2^-24, so 1 + m^(s·b) rounds to 1 and the formula gives
+    // exactly 1 (tested): most of a flat background, without the two powers.
+    if m <= NO_ELEVATION {
+        return 1.0;
+    }
+    (1.0 + m.powf(SLOPE * B)).powf(1.0 / B)
 }
+
+/// The largest masker [`threshold_elevation`] takes as no masking at all: 0.002^2.8 ≈ 2.8e-8 <
+/// 2^-24 ≈ 6.0e-8.
+const NO_ELEVATION: f32 = 0.002;
 
 /// 3×3 mean of |v| (phase-insensitive masker magnitude), borders clamped.
 pub(crate) fn local_magnitude(v: &[f32], w: usize, h: usize) -> Vec<f32> {
@@ -54,6 +64,20 @@ pub(crate) fn local_magnitude(v: &[f32], w: usize, h: usize) -> Vec<f32> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_shortcut_gives_what_the_formula_gives() {
+        let formula = |m: f32| (1.0 + m.abs().powf(SLOPE * B)).powf(1.0 / B);
+        // Every float from 0 to just past the shortcut's bound, in steps of 97 ulps, and the
+        // bound's neighbours.
+        let top = (NO_ELEVATION * 1.01).to_bits();
+        for bits in (0..top).step_by(97).chain(NO_ELEVATION.to_bits() - 8..top) {
+            let m = f32::from_bits(bits);
+            assert_eq!(threshold_elevation(m), formula(m), "{m}");
+            assert_eq!(threshold_elevation(-m), formula(-m), "{m}");
+        }
+        assert!(threshold_elevation(f32::NAN).is_nan());
+    }
 
     #[test]
     fn elevation_is_one_below_threshold_and_follows_the_slope_above() {

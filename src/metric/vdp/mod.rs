@@ -249,8 +249,19 @@ impl Vdp {
             h,
             v: lum
                 .v
-                .par_iter()
-                .map(|&l| l.max(adaptation::L_MIN as f32).ln())
+                .par_chunks(w)
+                .flat_map_iter(|row| {
+                    // A run of equal luminances (a flat background) takes one logarithm.
+                    let mut last = None;
+                    row.iter().map(move |&l| match last {
+                        Some((m, v)) if m == l => v,
+                        _ => {
+                            let v = l.max(adaptation::L_MIN as f32).ln();
+                            last = Some((l, v));
+                            v
+                        }
+                    })
+                })
                 .collect(),
         };
         let filtered = self.filter(w, h).apply(&log);
@@ -293,7 +304,15 @@ impl Vdp {
                 let (mr, mt) = (&reference.maskers[k], &test.maskers[k]);
                 let v = (0..rb.v.len())
                     .into_par_iter()
-                    .map(|i| (tb.v[i] - rb.v[i]) / threshold_elevation(mr[i].min(mt[i])))
+                    .map(|i| {
+                        // An unchanged sample stays 0 whatever the masking.
+                        let d = tb.v[i] - rb.v[i];
+                        if d == 0.0 {
+                            0.0
+                        } else {
+                            d / threshold_elevation(mr[i].min(mt[i]))
+                        }
+                    })
                     .collect();
                 Plane {
                     w: rb.w,

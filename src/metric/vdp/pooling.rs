@@ -53,6 +53,38 @@ fn box_line(line: &mut [f64], r: usize, tmp: &mut Vec<f64>) {
     }
 }
 
+/// Columns per block of [`probability_map`]'s vertical pass.
+const COLUMN_BLOCK: usize = 64;
+
+/// [`box_line`] down every column of `src` (`width` columns, row-major) at once, into `dst`.
+fn box_columns(src: &[f64], dst: &mut [f64], width: usize, r: usize) {
+    let h = src.len() / width;
+    let row = |i: isize| {
+        let y = i.clamp(0, h as isize - 1) as usize;
+        &src[y * width..(y + 1) * width]
+    };
+    let r = r as isize;
+    let mut acc: Vec<f64> = row(-r).to_vec();
+    for i in -r + 1..=r {
+        for (a, &s) in acc.iter_mut().zip(row(i)) {
+            *a += s;
+        }
+    }
+    let size = (2 * r + 1) as f64;
+    for (y, out) in dst.chunks_exact_mut(width).enumerate() {
+        let y = y as isize;
+        for (((o, a), &add), &sub) in out
+            .iter_mut()
+            .zip(&mut acc)
+            .zip(row(y + r + 1))
+            .zip(row(y - r))
+        {
+            *o = *a / size;
+            *a += add - sub;
+        }
+    }
+}
+
 /// Per-pixel detection probability of the difference around each pixel (see the module comment).
 pub(crate) fn probability_map(e: &[f64], w: usize, h: usize, ppd: f64) -> Vec<f32> {
     let sigma = MAP_WINDOW_DEG * ppd;
@@ -80,24 +112,32 @@ pub(crate) fn probability_map(e: &[f64], w: usize, h: usize, ppd: f64) -> Vec<f3
             box_line(row, r, tmp);
         }
     });
-    let mut t: Vec<f64> = vec![0.0; w * h];
-    t.par_chunks_mut(h)
-        .enumerate()
-        .for_each_init(Vec::new, |tmp, (x, col)| {
-            for (y, c) in col.iter_mut().enumerate() {
-                *c = v[y * w + x];
-            }
+    // The vertical boxes on blocks of columns, a row of the block at a time (the same sums per
+    // column as `box_line`'s, in the same order, without reading the image column-wise).
+    let blocks: Vec<Vec<f64>> = (0..w.div_ceil(COLUMN_BLOCK))
+        .into_par_iter()
+        .map(|b| {
+            let (x0, x1) = (b * COLUMN_BLOCK, ((b + 1) * COLUMN_BLOCK).min(w));
+            let mut cur: Vec<f64> = (0..h)
+                .flat_map(|y| v[y * w + x0..y * w + x1].iter().copied())
+                .collect();
+            let mut next = vec![0.0; cur.len()];
             for _ in 0..3 {
-                box_line(col, r, tmp);
+                box_columns(&cur, &mut next, x1 - x0, r);
+                std::mem::swap(&mut cur, &mut next);
             }
-        });
+            cur
+        })
+        .collect();
     let mut out = vec![0.0f32; w * h];
     out.par_chunks_mut(w).enumerate().for_each(|(y, row)| {
         for (x, o) in row.iter_mut().enumerate() {
             let windowed = if r == 0 {
                 e[y * w + x]
             } else {
-                t[x * h + y] * scale
+                let (b, i) = (x / COLUMN_BLOCK, x % COLUMN_BLOCK);
+                let bw = COLUMN_BLOCK.min(w - b * COLUMN_BLOCK);
+                blocks[b][y * bw + i] * scale
             };
             *o = psychometric::probability(windowed) as f32;
         }
