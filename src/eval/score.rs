@@ -31,6 +31,8 @@ pub struct Reference {
     image: LinearImage,
     flip: Option<FlipPrepared>,
     vdp: Option<VdpPrepared>,
+    /// SSIM's channel, for SSIM and MS-SSIM.
+    ssim: Option<ssim::SsimPrepared>,
 }
 
 /// Scores of one pair: values in metric-name order, and the error maps worth drawing.
@@ -81,6 +83,8 @@ impl Scorer {
             vdp: self
                 .has(MetricFamily::Vdp)
                 .then(|| self.vdp.prepare(&image)),
+            ssim: (self.has(MetricFamily::Ssim) || self.has(MetricFamily::Msssim))
+                .then(|| ssim::prepare(&image, ssim::SsimInput::SrgbLuma)),
             image,
         }
     }
@@ -88,6 +92,7 @@ impl Scorer {
     /// Score `test` against a prepared reference.
     pub fn score(&self, reference: &Reference, test: &LinearImage) -> Result<Scored> {
         let mut out = Scored::default();
+        let mut ssim_scores: Option<ssim::SsimScores> = None;
         for &family in &self.families {
             match family {
                 MetricFamily::Flip => {
@@ -104,22 +109,38 @@ impl Scorer {
                         .push(("flip_share", round7(over as f64 / v.len().max(1) as f64)));
                     out.maps.push(("flip", s.map));
                 }
-                MetricFamily::Ssim => {
-                    let (mean, map) =
-                        ssim::ssim(&reference.image, test, ssim::SsimInput::SrgbLuma)?;
-                    out.values.push(("ssim", round7(mean)));
+                MetricFamily::Ssim | MetricFamily::Msssim => {
+                    // One pass gives SSIM and MS-SSIM's first scale: made at the first of the
+                    // two families, recorded at each.
+                    if ssim_scores.is_none() {
+                        let prepared = reference.ssim.as_ref().expect("prepared with SSIM");
+                        let test = ssim::prepare(test, ssim::SsimInput::SrgbLuma);
+                        ssim_scores = Some(ssim::compare_prepared(
+                            prepared,
+                            &test,
+                            self.has(MetricFamily::Ssim),
+                            self.has(MetricFamily::Msssim),
+                        )?);
+                    }
+                    let scores = ssim_scores.as_mut().expect("made above");
+                    if family == MetricFamily::Msssim {
+                        out.values
+                            .push(("msssim", round7(scores.ms.unwrap_or_default())));
+                        continue;
+                    }
+                    out.values
+                        .push(("ssim", round7(scores.mean.unwrap_or_default())));
                     out.maps.push((
                         "ssim",
                         ErrorMap {
                             width: test.width(),
                             height: test.height(),
-                            values: map.iter().map(|s| (1.0 - s).clamp(0.0, 1.0)).collect(),
+                            values: std::mem::take(&mut scores.map)
+                                .iter()
+                                .map(|s| (1.0 - s).clamp(0.0, 1.0))
+                                .collect(),
                         },
                     ));
-                }
-                MetricFamily::Msssim => {
-                    let v = ssim::ms_ssim(&reference.image, test, ssim::SsimInput::SrgbLuma)?;
-                    out.values.push(("msssim", round7(v)));
                 }
                 MetricFamily::Psnr => {
                     let s = mse::mse(&reference.image, test)?;

@@ -16,6 +16,8 @@
 //! `f32` on values centred at 0.5 (no cancellation in E\[x²\] − E\[x\]²; the oracle pairs agree to
 //! < 5e-7) and combined in `f64`; bands of rows run in parallel and sums are combined in row order.
 
+use std::borrow::Cow;
+
 use rayon::prelude::*;
 
 use crate::color::{linear_to_srgb_fast, luminance};
@@ -89,7 +91,7 @@ fn kernel() -> [f64; 2 * RADIUS + 1] {
 }
 
 /// Rows per parallel band of the fused filter-and-score pass.
-const BAND: usize = 16;
+const BAND: usize = 64;
 
 /// Per-pixel SSIM terms, computed band by band: for each band of output rows, the five local
 /// moments (x, y, x², y², xy) are Gaussian-filtered horizontally for the band plus its ±5-row halo
@@ -209,10 +211,69 @@ pub fn ssim(
     input: SsimInput,
 ) -> Result<(f64, Vec<f32>)> {
     same_size(reference, test)?;
-    let (a, b) = (plane(reference, input), plane(test, input));
-    let (map, sums) = terms(&a, &b, true);
-    let [mean, _, _] = cropped_means(a.w, a.h, &sums).ok_or_else(|| too_small(a.w, a.h, "SSIM"))?;
-    Ok((mean, map))
+    let s = compare_prepared(
+        &prepare(reference, input),
+        &prepare(test, input),
+        true,
+        false,
+    )?;
+    Ok((s.mean.unwrap_or_default(), s.map))
+}
+
+/// One image's SSIM channel (see [`SsimInput`]), ready to be compared with several others.
+#[derive(Debug, Clone)]
+pub struct SsimPrepared(Plane);
+
+/// An image's SSIM channel.
+pub fn prepare(image: &LinearImage, input: SsimInput) -> SsimPrepared {
+    SsimPrepared(plane(image, input))
+}
+
+/// What [`compare_prepared`] found.
+#[derive(Debug, Clone, Default)]
+pub struct SsimScores {
+    /// Mean SSIM, where asked for.
+    pub mean: Option<f64>,
+    /// The per-pixel SSIM map (empty unless SSIM was asked for).
+    pub map: Vec<f32>,
+    /// MS-SSIM, where asked for.
+    pub ms: Option<f64>,
+}
+
+/// SSIM (mean and map) and MS-SSIM of two prepared channels, as asked for: MS-SSIM's first scale
+/// is SSIM's own pass over the full-size images, done once for both.
+pub fn compare_prepared(
+    reference: &SsimPrepared,
+    test: &SsimPrepared,
+    want_ssim: bool,
+    want_ms: bool,
+) -> Result<SsimScores> {
+    let (a, b) = (&reference.0, &test.0);
+    crate::image::same_dims((a.w, a.h), (b.w, b.h))?;
+    let min_side = (2 * RADIUS + 1) << (MS_WEIGHTS.len() - 1);
+    if want_ms && (a.w < min_side || a.h < min_side) {
+        return Err(Error::Usage(format!(
+            "MS-SSIM needs images of at least {min_side}x{min_side} pixels (got {}x{}); use SSIM",
+            a.w, a.h
+        )));
+    }
+    if !want_ssim && !want_ms {
+        return Ok(SsimScores::default());
+    }
+    let (map, sums) = terms(a, b, want_ssim);
+    let mut out = SsimScores {
+        map,
+        ..SsimScores::default()
+    };
+    if want_ssim {
+        let [mean, _, _] =
+            cropped_means(a.w, a.h, &sums).ok_or_else(|| too_small(a.w, a.h, "SSIM"))?;
+        out.mean = Some(mean);
+    }
+    if want_ms {
+        out.ms = Some(ms_ssim_from(a, b, &sums)?);
+    }
+    Ok(out)
 }
 
 /// 2×2 box average (odd trailing row/column dropped), as between MS-SSIM scales.
@@ -232,25 +293,33 @@ fn downsample(p: &Plane) -> Plane {
 /// window). Negative contrast–structure means are clamped to 0 before the power, a common guard.
 pub fn ms_ssim(reference: &LinearImage, test: &LinearImage, input: SsimInput) -> Result<f64> {
     same_size(reference, test)?;
-    let (mut a, mut b) = (plane(reference, input), plane(test, input));
-    let min_side = (2 * RADIUS + 1) << (MS_WEIGHTS.len() - 1);
-    if a.w < min_side || a.h < min_side {
-        return Err(Error::Usage(format!(
-            "MS-SSIM needs images of at least {min_side}x{min_side} pixels (got {}x{}); use SSIM",
-            a.w, a.h
-        )));
-    }
+    let s = compare_prepared(
+        &prepare(reference, input),
+        &prepare(test, input),
+        false,
+        true,
+    )?;
+    Ok(s.ms.unwrap_or_default())
+}
+
+/// MS-SSIM of `a` and `b` given the row sums of their full-size scale (`terms`).
+fn ms_ssim_from(a: &Plane, b: &Plane, first: &[[f64; 3]]) -> Result<f64> {
     let mut product = 1.0;
+    let (mut a, mut b) = (Cow::Borrowed(a), Cow::Borrowed(b));
     for (scale, &weight) in MS_WEIGHTS.iter().enumerate() {
-        let (_, sums) = terms(&a, &b, false);
+        let sums = if scale == 0 {
+            Cow::Borrowed(first)
+        } else {
+            Cow::Owned(terms(&a, &b, false).1)
+        };
         let [_, mean_cs, mean_l] =
             cropped_means(a.w, a.h, &sums).ok_or_else(|| too_small(a.w, a.h, "MS-SSIM"))?;
         if scale + 1 == MS_WEIGHTS.len() {
             product *= (mean_l * mean_cs).max(0.0).powf(weight);
         } else {
             product *= mean_cs.max(0.0).powf(weight);
-            a = downsample(&a);
-            b = downsample(&b);
+            a = Cow::Owned(downsample(&a));
+            b = Cow::Owned(downsample(&b));
         }
     }
     Ok(product)
