@@ -33,6 +33,8 @@ pub struct Reference {
     vdp: Option<VdpPrepared>,
     /// SSIM's channel, for SSIM and MS-SSIM.
     ssim: Option<ssim::SsimPrepared>,
+    /// 8-bit sRGB codes, for PSNR.
+    srgb8: Option<Vec<[u8; 3]>>,
 }
 
 /// Scores of one pair: values in metric-name order, and the error maps worth drawing.
@@ -85,6 +87,9 @@ impl Scorer {
                 .then(|| self.vdp.prepare(&image)),
             ssim: (self.has(MetricFamily::Ssim) || self.has(MetricFamily::Msssim))
                 .then(|| ssim::prepare(&image, ssim::SsimInput::SrgbLuma)),
+            srgb8: self
+                .has(MetricFamily::Psnr)
+                .then(|| mse::srgb8_codes(&image)),
             image,
         }
     }
@@ -144,7 +149,9 @@ impl Scorer {
                 }
                 MetricFamily::Psnr => {
                     let s = mse::mse(&reference.image, test)?;
-                    let rgb = mse::psnr_srgb8(&reference.image, test)?;
+                    let codes = reference.srgb8.as_ref().expect("prepared with PSNR");
+                    let rgb =
+                        mse::psnr_srgb8_codes(codes, &mse::srgb8_codes(test), test.width());
                     out.values.push(("psnr", round7(rgb)));
                     out.values.push(("psnr_luminance", round7(s.psnr_db)));
                     out.values.push(("mse", round7(s.mse)));

@@ -381,8 +381,12 @@ impl Flip {
                 // Feature difference (paper §4).
                 let [er, pr] = reference.features[i];
                 let [et, pt] = test.features[i];
-                let df = (inv_sqrt2 * (er - et).abs().max((pr - pt).abs())).powf(QF);
-                dc.powf(1.0 - df)
+                let feature = inv_sqrt2 * (er - et).abs().max((pr - pt).abs());
+                if feature == 0.0 {
+                    // ΔE_f = 0: ΔE_c^1 (what the powers give, exactly).
+                    return dc;
+                }
+                dc.powf(1.0 - feature.powf(QF))
             })
             .collect();
         let mean = super::pool::mean(&values, reference.width);

@@ -23,12 +23,19 @@ pub fn percentile(values: &[f32], p: f64) -> f64 {
     if values.is_empty() {
         return 0.0;
     }
-    let mut sorted = values.to_vec();
-    sorted.par_sort_unstable_by(|a, b| a.total_cmp(b));
-    let rank = p.clamp(0.0, 100.0) / 100.0 * (sorted.len() - 1) as f64;
+    let mut v = values.to_vec();
+    let rank = p.clamp(0.0, 100.0) / 100.0 * (v.len() - 1) as f64;
     let (lo, hi) = (rank.floor() as usize, rank.ceil() as usize);
     let t = rank - lo as f64;
-    sorted[lo] as f64 * (1.0 - t) + sorted[hi] as f64 * t
+    // The lo-th and hi-th values in ascending (total) order, by selection rather than a sort:
+    // the hi-th is lo-th or the smallest of those after it.
+    let (_, &mut at_lo, above) = v.select_nth_unstable_by(lo, |a, b| a.total_cmp(b));
+    let at_hi = if hi == lo {
+        at_lo
+    } else {
+        above.iter().copied().min_by(|a, b| a.total_cmp(b)).unwrap_or(at_lo)
+    };
+    at_lo as f64 * (1.0 - t) + at_hi as f64 * t
 }
 
 /// FLIP's weighted percentile (`p` in 0..=1): each value weighted by itself, so larger errors
