@@ -167,7 +167,9 @@ pub fn evaluate(
             .map(|l| engine.scene(&l.scene))
             .collect::<Result<Vec<_>>>()?;
         let mut sheets: Vec<SheetViews> = vec![Vec::new(); lods.len()];
-        for (v, camera) in cameras.iter().enumerate() {
+        // The original's frame of view v, prepared for scoring, and its thumbnail.
+        let reference_view = |v: usize| -> Result<_> {
+            let camera = &cameras[v];
             // The original's colour, from the cache where it holds this very frame.
             let cached = cache
                 .as_ref()
@@ -185,45 +187,65 @@ pub fn evaluate(
                 }
             };
             let ref_thumb = thumbnail(&reference_image.to_srgb8());
-            let prepared = scorer.prepare(reference_image);
+            Ok((scorer.prepare(reference_image), ref_thumb))
+        };
+        let mut next = (!cameras.is_empty()).then(|| reference_view(0));
+        for (v, camera) in cameras.iter().enumerate() {
+            let (prepared, ref_thumb) = next.take().expect("prepared ahead")?;
             // The LODs of one view are independent: render and score them in parallel, then
             // record them in LOD order (outputs never depend on which finished first).
-            let per_lod = lods
-                .par_iter()
-                .zip(&lod_renderers)
-                .map(|(lod, lod_renderer)| -> Result<_> {
-                    let test_frame = lod_renderer.render(camera, &settings)?;
-                    let scored = scorer.score(&prepared, &LinearImage::from(&test_frame))?;
-                    if let Some(out_dir) = images
-                        && cfg.images.heatmaps == HeatmapChoice::All
-                    {
-                        for (metric, map) in &scored.maps {
-                            write_heat_map(out_dir, &asset.name, &lod.name, v, metric, map)?;
-                        }
-                    }
-                    let thumbs = scored.maps.first().map(|(metric, map)| {
-                        let heat = colormap::heat_map(&map.values, map.width, map.height, 0);
-                        let score = scored
-                            .values
-                            .iter()
-                            .find(|(m, _)| m == metric)
-                            .map_or(String::new(), |(_, x)| format!(" {x:.4}"));
-                        [
-                            captioned(ref_thumb.clone(), &format!("view {v} · original")),
-                            captioned(
-                                thumbnail(&test_frame.to_srgb8()),
-                                &format!("view {v} · {}", lod.name),
-                            ),
-                            captioned(
-                                thumbnail(&heat),
-                                &format!("{}{score}", metric.to_uppercase()),
-                            ),
-                        ]
-                    });
-                    bar.advance(1);
-                    Ok((scored.values, thumbs))
-                })
-                .collect::<Result<Vec<_>>>()?;
+            // The next view's original is prepared meanwhile, so that no core waits for it.
+            let (per_lod, following) = rayon::join(
+                || {
+                    lods.par_iter()
+                        .zip(&lod_renderers)
+                        .map(|(lod, lod_renderer)| -> Result<_> {
+                            let test_frame = lod_renderer.render(camera, &settings)?;
+                            let scored =
+                                scorer.score(&prepared, &LinearImage::from(&test_frame))?;
+                            if let Some(out_dir) = images
+                                && cfg.images.heatmaps == HeatmapChoice::All
+                            {
+                                for (metric, map) in &scored.maps {
+                                    write_heat_map(
+                                        out_dir,
+                                        &asset.name,
+                                        &lod.name,
+                                        v,
+                                        metric,
+                                        map,
+                                    )?;
+                                }
+                            }
+                            let thumbs = scored.maps.first().map(|(metric, map)| {
+                                let heat =
+                                    colormap::heat_map(&map.values, map.width, map.height, 0);
+                                let score = scored
+                                    .values
+                                    .iter()
+                                    .find(|(m, _)| m == metric)
+                                    .map_or(String::new(), |(_, x)| format!(" {x:.4}"));
+                                [
+                                    captioned(ref_thumb.clone(), &format!("view {v} · original")),
+                                    captioned(
+                                        thumbnail(&test_frame.to_srgb8()),
+                                        &format!("view {v} · {}", lod.name),
+                                    ),
+                                    captioned(
+                                        thumbnail(&heat),
+                                        &format!("{}{score}", metric.to_uppercase()),
+                                    ),
+                                ]
+                            });
+                            bar.advance(1);
+                            Ok((scored.values, thumbs))
+                        })
+                        .collect::<Result<Vec<_>>>()
+                },
+                || (v + 1 < cameras.len()).then(|| reference_view(v + 1)),
+            );
+            let per_lod = per_lod?;
+            next = following;
             for (k, (lod, (values, thumbs))) in lods.iter().zip(per_lod).enumerate() {
                 for (metric, value) in values {
                     results.rows.push(MetricRow {

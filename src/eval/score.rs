@@ -150,8 +150,7 @@ impl Scorer {
                 MetricFamily::Psnr => {
                     let s = mse::mse(&reference.image, test)?;
                     let codes = reference.srgb8.as_ref().expect("prepared with PSNR");
-                    let rgb =
-                        mse::psnr_srgb8_codes(codes, &mse::srgb8_codes(test), test.width());
+                    let rgb = mse::psnr_srgb8_codes(codes, &mse::srgb8_codes(test), test.width());
                     out.values.push(("psnr", round7(rgb)));
                     out.values.push(("psnr_luminance", round7(s.psnr_db)));
                     out.values.push(("mse", round7(s.mse)));

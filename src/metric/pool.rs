@@ -33,7 +33,11 @@ pub fn percentile(values: &[f32], p: f64) -> f64 {
     let at_hi = if hi == lo {
         at_lo
     } else {
-        above.iter().copied().min_by(|a, b| a.total_cmp(b)).unwrap_or(at_lo)
+        above
+            .iter()
+            .copied()
+            .min_by(|a, b| a.total_cmp(b))
+            .unwrap_or(at_lo)
     };
     at_lo as f64 * (1.0 - t) + at_hi as f64 * t
 }
