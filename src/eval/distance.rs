@@ -203,9 +203,16 @@ impl<'a> Prober<'a> {
     }
 
     /// Worst over the views at on-screen diameter `diameter` (pixels); `originals` holds (and
-    /// receives) the original's prepared renders. Views run in parallel; the worst is a maximum,
-    /// the same in any order.
-    fn at(&self, diameter: f64, originals: &OriginalProbes) -> Result<Probe> {
+    /// receives) the original's prepared renders. Views run two at a time in parallel, in the
+    /// job's order; where `enough` holds for the worst so far the rest are skipped (the worst can
+    /// only grow) and the probe comes back marked incomplete. The worst is a maximum, the same in
+    /// any order.
+    fn at(
+        &self,
+        diameter: f64,
+        originals: &OriginalProbes,
+        enough: Option<&dyn Fn(&Probe) -> bool>,
+    ) -> Result<Probe> {
         let (display, sphere) = (&self.display, self.sphere);
         let r_units = sphere.radius as f64;
         let d_units = display.distance_for(r_units, diameter);
@@ -217,57 +224,66 @@ impl<'a> Prober<'a> {
         s.samples = SamplePattern::Rotated(self.side);
         // The crop's field of view at the display's pixel scale.
         let fov = 2.0 * ((size as f64 / 2.0) / display.k).atan();
-        let per_view = self
-            .job
-            .directions
-            .par_iter()
-            .map(|&dir| -> Result<Probe> {
-                let mut cam = Camera::frame_sphere(sphere, dir, 30.0, 1.0, 0.0);
-                let dir = cam.to_eye();
-                cam.eye = sphere.center + dir * d_units as f32;
-                cam.projection = Projection::Perspective {
-                    fov_y_deg: fov.to_degrees() as f32,
-                };
-                cam.near = ((d_units - r_units * 1.01) as f32).max(d_units as f32 * 1e-4);
-                cam.far = (d_units + r_units * 1.01) as f32;
-                let key = (
-                    diameter.to_bits(),
-                    dir.to_array().map(f32::to_bits),
-                    self.side,
-                    self.flip.is_some(),
-                );
-                let a = originals.get_or_make(key, || {
-                    let a = LinearImage::from(&raster::render(self.job.original, &cam, &s)?);
-                    Ok(PreparedOriginal {
-                        vdp: self.vdp.prepare(&a),
-                        flip: self.flip.as_ref().map(|f| f.prepare(&a)),
-                    })
-                })?;
-                let b = LinearImage::from(&raster::render(self.job.lod, &cam, &s)?);
-                let v = self.vdp.compare_prepared(&a.vdp, &self.vdp.prepare(&b))?;
-                let f = match (&self.flip, &a.flip) {
-                    (Some(flip), Some(fa)) => flip.compare_prepared(fa, &flip.prepare(&b))?.mean,
-                    _ => 0.0,
-                };
-                Ok(Probe {
-                    vdp: v.probability,
-                    vdp_jnd: v.jnd,
-                    flip: f,
+        let view = |dir: Vec3| -> Result<Probe> {
+            let mut cam = Camera::frame_sphere(sphere, dir, 30.0, 1.0, 0.0);
+            let dir = cam.to_eye();
+            cam.eye = sphere.center + dir * d_units as f32;
+            cam.projection = Projection::Perspective {
+                fov_y_deg: fov.to_degrees() as f32,
+            };
+            cam.near = ((d_units - r_units * 1.01) as f32).max(d_units as f32 * 1e-4);
+            cam.far = (d_units + r_units * 1.01) as f32;
+            let key = (
+                diameter.to_bits(),
+                dir.to_array().map(f32::to_bits),
+                self.side,
+                self.flip.is_some(),
+            );
+            let a = originals.get_or_make(key, || {
+                let a = LinearImage::from(&raster::render(self.job.original, &cam, &s)?);
+                Ok(PreparedOriginal {
+                    vdp: self.vdp.prepare(&a),
+                    flip: self.flip.as_ref().map(|f| f.prepare(&a)),
                 })
+            })?;
+            let b = LinearImage::from(&raster::render(self.job.lod, &cam, &s)?);
+            let v = self.vdp.compare_prepared(&a.vdp, &self.vdp.prepare(&b))?;
+            let f = match (&self.flip, &a.flip) {
+                (Some(flip), Some(fa)) => flip.compare_prepared(fa, &flip.prepare(&b))?.mean,
+                _ => 0.0,
+            };
+            Ok(Probe {
+                vdp: v.probability,
+                vdp_jnd: v.jnd,
+                flip: f,
+                complete: true,
             })
-            .collect::<Result<Vec<_>>>()?;
-        Ok(per_view.iter().fold(
-            Probe {
-                vdp: 0.0,
-                vdp_jnd: 0.0,
-                flip: 0.0,
-            },
-            |w, p| Probe {
+        };
+        let mut worst = Probe {
+            vdp: 0.0,
+            vdp_jnd: 0.0,
+            flip: 0.0,
+            complete: true,
+        };
+        let chunks = self.job.directions.chunks(2);
+        let n = chunks.len();
+        for (i, pair) in chunks.enumerate() {
+            let per_view = pair
+                .par_iter()
+                .map(|&dir| view(dir))
+                .collect::<Result<Vec<_>>>()?;
+            worst = per_view.iter().fold(worst, |w, p| Probe {
                 vdp: w.vdp.max(p.vdp),
                 vdp_jnd: w.vdp_jnd.max(p.vdp_jnd),
                 flip: w.flip.max(p.flip),
-            },
-        ))
+                complete: true,
+            });
+            if i + 1 < n && enough.is_some_and(|e| e(&worst)) {
+                worst.complete = false;
+                break;
+            }
+        }
+        Ok(worst)
     }
 }
 
@@ -289,7 +305,7 @@ pub fn visibility_at(
         .diameter_px(r_m, distance_m.max(r_m * 1.0001))
         .min(crate::limits::IMAGE_SIDE.max as f64 / 1.1 - 16.0);
     let own = OriginalProbes::new();
-    let p = prober.at(diameter, job.originals.unwrap_or(&own))?;
+    let p = prober.at(diameter, job.originals.unwrap_or(&own), None)?;
     Ok((p.vdp, p.vdp_jnd, p.flip))
 }
 
@@ -302,6 +318,9 @@ struct Probe {
     vdp: f64,
     vdp_jnd: f64,
     flip: f64,
+    /// Every view scored: false where the probe stopped early, already visible by every
+    /// criterion (its decisions hold, its values are lower bounds).
+    complete: bool,
 }
 
 /// Find the distances for one LOD: one row for the VDP criterion and one for FLIP if configured.
@@ -322,15 +341,6 @@ pub fn search(
     let own = OriginalProbes::new();
     let originals = job.originals.unwrap_or(&own);
     let r_units = prober.sphere.radius as f64;
-    let mut probes: BTreeMap<u32, Probe> = BTreeMap::new();
-    let mut probe = |diameter: u32| -> Result<Probe> {
-        if let Some(p) = probes.get(&diameter) {
-            return Ok(*p);
-        }
-        let worst = prober.at(diameter as f64, originals)?;
-        probes.insert(diameter, worst);
-        Ok(worst)
-    };
     // The sizes searched: MIN_PROBE to max_diameter_px, widened to take in the size at the
     // switch distance (up to the display's height) so that the gate's question has an answer.
     let r_m = r_units * job.meters_per_unit;
@@ -348,6 +358,21 @@ pub fn search(
             Box::new(move |p: &Probe| p.flip > f.0),
         ));
     }
+    // A probe may stop once every criterion sees the LOD (its decisions are then final); one
+    // whose values are reported is completed.
+    let all_visible = |p: &Probe| criteria.iter().all(|(_, visible)| visible(p));
+    let mut probes: BTreeMap<u32, Probe> = BTreeMap::new();
+    let mut probe = |diameter: u32, full: bool| -> Result<Probe> {
+        if let Some(p) = probes.get(&diameter)
+            && (p.complete || !full)
+        {
+            return Ok(*p);
+        }
+        let enough: Option<&dyn Fn(&Probe) -> bool> = if full { None } else { Some(&all_visible) };
+        let worst = prober.at(diameter as f64, originals, enough)?;
+        probes.insert(diameter, worst);
+        Ok(worst)
+    };
     let mut rows = Vec::new();
     for (criterion, visible) in &criteria {
         // Bracket: double from the smallest probe until visible or at the limit.
@@ -355,7 +380,7 @@ pub fn search(
         let mut hi = None; // smallest diameter known visible
         let mut d = min_d;
         loop {
-            if visible(&probe(d)?) {
+            if visible(&probe(d, false)?) {
                 hi = Some(d);
                 break;
             }
@@ -369,7 +394,7 @@ pub fn search(
         if let Some(mut h) = hi {
             while lo > 0 && (h as f64) > lo as f64 * 1.02 && h - lo > 1 {
                 let mid = ((lo as f64 * h as f64).sqrt().round() as u32).clamp(lo + 1, h - 1);
-                if visible(&probe(mid)?) {
+                if visible(&probe(mid, false)?) {
                     h = mid;
                 } else {
                     lo = mid;
@@ -384,7 +409,7 @@ pub fn search(
             (None, _) => DistanceBound::AtMost,
         };
         let diameter = if lo == 0 { min_d } else { lo };
-        let at = probe(diameter)?;
+        let at = probe(diameter, true)?;
         let d_m = display.distance_for(r_m, diameter as f64);
         let (fraction, unreal, coverage) = display.engine_params(r_m, d_m);
         rows.push(DistanceRow {

@@ -263,39 +263,61 @@ pub fn evaluate(
                 }
             }
         }
-        for (k, lod) in lods.iter().enumerate() {
-            let order = worst_first(&results, &asset.name, &lod.name, &cfg.metrics);
-            if let Some(out_dir) = images
-                && cfg.images.heatmaps == HeatmapChoice::Worst
-                && let Some(&worst) = order.first()
-            {
-                // Re-render the worst view only, for its heat maps.
-                let a = LinearImage::from(&reference_renderer.render(&cameras[worst], &settings)?);
-                let b = LinearImage::from(&lod_renderers[k].render(&cameras[worst], &settings)?);
-                let scored = scorer.score(&scorer.prepare(a), &b)?;
-                for (metric, map) in &scored.maps {
-                    write_heat_map(out_dir, &asset.name, &lod.name, worst, metric, map)?;
-                }
+        let orders: Vec<Vec<usize>> = lods
+            .iter()
+            .map(|lod| worst_first(&results, &asset.name, &lod.name, &cfg.metrics))
+            .collect();
+        if let Some(out_dir) = images
+            && cfg.images.heatmaps == HeatmapChoice::Worst
+        {
+            // Re-render the worst view only, for its heat maps: each distinct worst view's
+            // original once, its LODs in parallel.
+            let mut worst: Vec<usize> = orders.iter().filter_map(|o| o.first().copied()).collect();
+            worst.sort_unstable();
+            worst.dedup();
+            for view in worst {
+                let camera = &cameras[view];
+                let a = LinearImage::from(&reference_renderer.render(camera, &settings)?);
+                let reference = scorer.prepare(a);
+                lods.par_iter()
+                    .zip(&lod_renderers)
+                    .zip(&orders)
+                    .filter(|(_, order)| order.first() == Some(&view))
+                    .map(|((lod, lod_renderer), _)| -> Result<()> {
+                        let b = LinearImage::from(&lod_renderer.render(camera, &settings)?);
+                        let scored = scorer.score(&reference, &b)?;
+                        for (metric, map) in &scored.maps {
+                            write_heat_map(out_dir, &asset.name, &lod.name, view, metric, map)?;
+                        }
+                        Ok(())
+                    })
+                    .collect::<Result<()>>()?;
             }
-            if let Some(out_dir) = images
-                && cfg.images.contact_sheets
-                && !sheets[k].is_empty()
-            {
-                let mut tiles = Vec::new();
-                for &v in order.iter().take(cfg.images.sheet_views.max(1)) {
-                    if let Some((_, t)) = sheets[k].iter().find(|(view, _)| *view == v) {
-                        tiles.extend(t.iter().cloned());
+        }
+        if let Some(out_dir) = images
+            && cfg.images.contact_sheets
+        {
+            lods.par_iter()
+                .zip(&sheets)
+                .zip(&orders)
+                .filter(|((_, sheet), _)| !sheet.is_empty())
+                .map(|((lod, sheet), order)| -> Result<()> {
+                    let mut tiles = Vec::new();
+                    for &v in order.iter().take(cfg.images.sheet_views.max(1)) {
+                        if let Some((_, t)) = sheet.iter().find(|(view, _)| *view == v) {
+                            tiles.extend(t.iter().cloned());
+                        }
                     }
-                }
-                let sheet = raster::contact_sheet(&tiles, 3, 4, [32, 32, 32])?;
-                crate::io::write_image(
-                    &out_dir
-                        .join("sheets")
-                        .join(&asset.name)
-                        .join(format!("{}.png", lod.name)),
-                    &image::DynamicImage::ImageRgb8(sheet),
-                )?;
-            }
+                    let sheet = raster::contact_sheet(&tiles, 3, 4, [32, 32, 32])?;
+                    crate::io::write_image(
+                        &out_dir
+                            .join("sheets")
+                            .join(&asset.name)
+                            .join(format!("{}.png", lod.name)),
+                        &image::DynamicImage::ImageRgb8(sheet),
+                    )
+                })
+                .collect::<Result<()>>()?;
         }
         if cfg.distance.enabled {
             // The LODs' searches in parallel, sharing the original's probe renders; rows in LOD
@@ -305,8 +327,8 @@ pub fn evaluate(
             let take = cfg.distance.views.unwrap_or(3).max(1);
             let rows = lods
                 .par_iter()
-                .map(|lod| {
-                    let order = worst_first(&results, &asset.name, &lod.name, &cfg.metrics);
+                .zip(&orders)
+                .map(|(lod, order)| {
                     let job = DistanceJob {
                         original: &reference,
                         lod: &lod.scene,
