@@ -15,6 +15,7 @@
 //!   LOD's worst views first, as 256-pixel thumbnails, each captioned inside the PNG (the view
 //!   number and which image it is; the heat map's metric and that view's score).
 
+use std::borrow::Cow;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
@@ -186,8 +187,9 @@ pub fn evaluate(
                     image
                 }
             };
-            let ref_thumb = thumbnail(&reference_image.to_srgb8());
-            Ok((scorer.prepare(reference_image), ref_thumb))
+            let prepared = scorer.prepare(reference_image);
+            let ref_thumb = thumbnail(&prepared.srgb8());
+            Ok((prepared, ref_thumb))
         };
         let mut next = (!cameras.is_empty()).then(|| reference_view(0));
         for (v, camera) in cameras.iter().enumerate() {
@@ -218,6 +220,10 @@ pub fn evaluate(
                                 }
                             }
                             let thumbs = scored.maps.first().map(|(metric, map)| {
+                                let test_rgb8: Cow<image::RgbImage> = match &scored.srgb8 {
+                                    Some(rgb) => Cow::Borrowed(rgb),
+                                    None => Cow::Owned(test_frame.to_srgb8()),
+                                };
                                 let heat =
                                     colormap::heat_map(&map.values, map.width, map.height, 0);
                                 let score = scored
@@ -228,7 +234,7 @@ pub fn evaluate(
                                 [
                                     captioned(ref_thumb.clone(), &format!("view {v} · original")),
                                     captioned(
-                                        thumbnail(&test_frame.to_srgb8()),
+                                        thumbnail(&test_rgb8),
                                         &format!("view {v} · {}", lod.name),
                                     ),
                                     captioned(

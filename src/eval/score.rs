@@ -44,6 +44,8 @@ pub struct Scored {
     pub values: Vec<(&'static str, f64)>,
     /// (metric, per-pixel map in [0, 1] where larger is worse).
     pub maps: Vec<(&'static str, ErrorMap)>,
+    /// The test image in 8-bit sRGB, where PSNR made it anyway.
+    pub srgb8: Option<image::RgbImage>,
 }
 
 impl Scored {
@@ -51,6 +53,26 @@ impl Scored {
     pub fn get(&self, metric: &str) -> Option<f64> {
         self.values.iter().find(|v| v.0 == metric).map(|v| v.1)
     }
+}
+
+impl Reference {
+    /// The reference in 8-bit sRGB (what `LinearImage::to_srgb8` gives), from the codes kept for
+    /// PSNR where there are any.
+    pub fn srgb8(&self) -> image::RgbImage {
+        self.srgb8
+            .as_ref()
+            .and_then(|c| rgb_image(self.image.width(), self.image.height(), c))
+            .unwrap_or_else(|| self.image.to_srgb8())
+    }
+}
+
+/// An 8-bit RGB image of per-pixel codes.
+fn rgb_image(width: usize, height: usize, codes: &[[u8; 3]]) -> Option<image::RgbImage> {
+    image::RgbImage::from_raw(
+        width as u32,
+        height as u32,
+        codes.iter().flatten().copied().collect(),
+    )
 }
 
 impl Scorer {
@@ -150,7 +172,9 @@ impl Scorer {
                 MetricFamily::Psnr => {
                     let s = mse::mse(&reference.image, test)?;
                     let codes = reference.srgb8.as_ref().expect("prepared with PSNR");
-                    let rgb = mse::psnr_srgb8_codes(codes, &mse::srgb8_codes(test), test.width());
+                    let test_codes = mse::srgb8_codes(test);
+                    let rgb = mse::psnr_srgb8_codes(codes, &test_codes, test.width());
+                    out.srgb8 = rgb_image(test.width(), test.height(), &test_codes);
                     out.values.push(("psnr", round7(rgb)));
                     out.values.push(("psnr_luminance", round7(s.psnr_db)));
                     out.values.push(("mse", round7(s.mse)));
