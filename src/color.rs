@@ -71,7 +71,7 @@ pub fn linear_to_srgb8(c: f32) -> u8 {
         Tables { steps, start }
     });
     // NaN and everything at or below zero encode as 0, everything at or above one as 255.
-    if !(c > 0.0) {
+    if c.is_nan() || c <= 0.0 {
         return 0;
     }
     if c >= 1.0 {
