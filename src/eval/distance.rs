@@ -330,6 +330,17 @@ pub fn search(
     viewing: &ViewingConfig,
     settings: &RenderSettings,
 ) -> Result<Vec<DistanceRow>> {
+    search_probing(job, config, viewing, settings, true)
+}
+
+/// [`search`], with probes that stop early (`early`) or score every view (the test's reference).
+fn search_probing(
+    job: &DistanceJob,
+    config: &DistanceConfig,
+    viewing: &ViewingConfig,
+    settings: &RenderSettings,
+    early: bool,
+) -> Result<Vec<DistanceRow>> {
     let display = Screen::new(viewing);
     let prober = Prober::new(
         job,
@@ -368,7 +379,11 @@ pub fn search(
         {
             return Ok(*p);
         }
-        let enough: Option<&dyn Fn(&Probe) -> bool> = if full { None } else { Some(&all_visible) };
+        let enough: Option<&dyn Fn(&Probe) -> bool> = if full || !early {
+            None
+        } else {
+            Some(&all_visible)
+        };
         let worst = prober.at(diameter as f64, originals, enough)?;
         probes.insert(diameter, worst);
         Ok(worst)
@@ -463,6 +478,52 @@ fn probe_range(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn probes_that_stop_early_give_the_rows_of_full_probes() {
+        // Spot against its 5 % LOD from four views, both criteria: the early stops change no
+        // decision and no reported value, and a shared cache of the original's probes changes
+        // nothing either.
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("reference/models/spot/spot_mtl.obj");
+        let mesh = crate::mesh::load(&path, &Default::default()).unwrap();
+        let lod = crate::simplify::chain(
+            &mesh,
+            crate::simplify::Method::Meshopt,
+            &[crate::simplify::Goal::Ratio(0.05)],
+        )
+        .unwrap()
+        .remove(0)
+        .mesh;
+        let (original, lod) = (
+            RenderScene::of(std::sync::Arc::new(mesh)),
+            RenderScene::of(std::sync::Arc::new(lod)),
+        );
+        let shared = OriginalProbes::new();
+        let job = |originals| DistanceJob {
+            original: &original,
+            lod: &lod,
+            directions: crate::scene::Rig::Dodecahedron.directions()[..4].to_vec(),
+            meters_per_unit: 0.5,
+            simplifier_error: None,
+            names: ("spot", "r5", 0),
+            switch_m: None,
+            originals,
+        };
+        let config = DistanceConfig {
+            samples: SampleCount(4),
+            max_diameter_px: crate::eval::config::ImageSize(96),
+            ..DistanceConfig::default()
+        };
+        let (viewing, settings) = (ViewingConfig::default(), RenderSettings::DEFAULT);
+        let full = search_probing(&job(None), &config, &viewing, &settings, false).unwrap();
+        let early = search_probing(&job(None), &config, &viewing, &settings, true).unwrap();
+        let cached = search(&job(Some(&shared)), &config, &viewing, &settings).unwrap();
+        assert_eq!(full.len(), 2);
+        assert_eq!(full, early);
+        assert_eq!(full, cached);
+        assert!(!shared.lock().is_empty());
+    }
 
     #[test]
     fn distance_and_diameter_are_inverse() {

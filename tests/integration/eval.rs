@@ -64,6 +64,58 @@ fn assert_same_tree(a: &Path, b: &Path) {
 const CHAIN: &str = "generate = { method = \"meshopt\", ratios = [0.5, 0.25] }";
 
 #[test]
+fn worst_view_heat_maps_equal_the_same_views_maps_of_a_full_run_for_any_thread_count() {
+    // Worst-view heat maps are re-rendered, one original per distinct worst view with its LODs in
+    // parallel: each must be byte for byte the map a run writing every view's maps writes there,
+    // and the distances (probes that stop early from three views) the same for 1, 2 and 8 threads.
+    let dir = tempfile::tempdir().unwrap();
+    let assets = asset(
+        "spot",
+        &model("spot/spot_mtl.obj"),
+        "generate = { method = \"meshopt\", ratios = [0.5, 0.1, 0.02] }",
+    );
+    let cfg = |heatmaps: &str| {
+        let sub = dir.path().join(heatmaps);
+        std::fs::create_dir_all(&sub).unwrap();
+        let extra = format!("[images]\nheatmaps = \"{heatmaps}\"");
+        let path = config(&sub, &extra, &assets);
+        let text = std::fs::read_to_string(&path).unwrap();
+        std::fs::write(&path, text.replace("views = 1", "views = 3")).unwrap();
+        path
+    };
+    let (all_cfg, worst_cfg) = (cfg("all"), cfg("worst"));
+    let run = |cfg: &Path, out: &str, threads: &str| {
+        let out = dir.path().join(out);
+        let r = lodeval([
+            "eval",
+            cfg.to_str().unwrap(),
+            "--threads",
+            threads,
+            "--out",
+            out.to_str().unwrap(),
+        ]);
+        assert_eq!(r.code, 0, "{}", r.stderr);
+        out
+    };
+    let all = files(&run(&all_cfg, "all-out", "2"));
+    let worst: Vec<PathBuf> = ["1", "2", "8"]
+        .iter()
+        .map(|t| run(&worst_cfg, &format!("worst{t}"), t))
+        .collect();
+    assert_same_tree(&worst[0], &worst[1]);
+    assert_same_tree(&worst[0], &worst[2]);
+    let worst = files(&worst[0]);
+    let maps: Vec<&PathBuf> = worst.keys().filter(|p| p.starts_with("heatmaps")).collect();
+    // Three LODs, one view each, FLIP, SSIM and the VDP.
+    assert_eq!(maps.len(), 3 * 3, "{maps:?}");
+    for m in maps {
+        assert!(all[m] == worst[m], "{} differs", m.display());
+    }
+    let distances = Path::new("distances.csv");
+    assert!(all[distances] == worst[distances], "distances differ");
+}
+
+#[test]
 fn outputs_are_identical_for_any_thread_count_and_merged_shards_equal_one_run() {
     let dir = tempfile::tempdir().unwrap();
     let assets = asset("bunny3k", &model("bunny/bunny_odedstein_3k.obj"), CHAIN)

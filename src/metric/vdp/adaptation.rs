@@ -66,17 +66,7 @@ impl BandAdaptation {
         let gains: Vec<f32> = adapt
             .v
             .par_chunks(aw)
-            .flat_map_iter(|row| {
-                let mut last = None;
-                row.iter().map(move |&l| match last {
-                    Some((m, g)) if m == l => g,
-                    _ => {
-                        let g = self.gain(l);
-                        last = Some((l, g));
-                        g
-                    }
-                })
-            })
+            .flat_map_iter(|row| super::map_runs(row, |l| self.gain(l)))
             .collect();
         band.v.par_chunks_mut(w).enumerate().for_each(|(y, row)| {
             let grow = &gains[(y / 2).min(ah - 1) * aw..][..aw];

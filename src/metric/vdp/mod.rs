@@ -140,6 +140,24 @@ pub struct VdpScore {
     pub map: ErrorMap,
 }
 
+/// `f` of every value of `row`, evaluated once per run of equal values (a flat background
+/// costs one call): the same values as mapping every element, for an `f` that maps 0 and −0
+/// alike (runs compare with `==`).
+pub(crate) fn map_runs<'a>(
+    row: &'a [f32],
+    f: impl Fn(f32) -> f32 + 'a,
+) -> impl Iterator<Item = f32> + 'a {
+    let mut last: Option<(f32, f32)> = None;
+    row.iter().map(move |&x| match last {
+        Some((m, y)) if m == x => y,
+        _ => {
+            let y = f(x);
+            last = Some((x, y));
+            y
+        }
+    })
+}
+
 impl Vdp {
     /// Default number of pyramid levels (octaves); fewer when the image is small.
     pub const DEFAULT_LEVELS: usize = 8;
@@ -250,18 +268,7 @@ impl Vdp {
             v: lum
                 .v
                 .par_chunks(w)
-                .flat_map_iter(|row| {
-                    // A run of equal luminances (a flat background) takes one logarithm.
-                    let mut last = None;
-                    row.iter().map(move |&l| match last {
-                        Some((m, v)) if m == l => v,
-                        _ => {
-                            let v = l.max(adaptation::L_MIN as f32).ln();
-                            last = Some((l, v));
-                            v
-                        }
-                    })
-                })
+                .flat_map_iter(|row| map_runs(row, |l| l.max(adaptation::L_MIN as f32).ln()))
                 .collect(),
         };
         let filtered = self.filter(w, h).apply(&log);
