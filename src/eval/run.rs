@@ -273,59 +273,67 @@ pub fn evaluate(
             .iter()
             .map(|lod| worst_first(&results, &asset.name, &lod.name, &cfg.metrics))
             .collect();
-        if let Some(out_dir) = images
-            && cfg.images.heatmaps == HeatmapChoice::Worst
-        {
-            // Re-render the worst view only, for its heat maps: each distinct worst view's
-            // original once, its LODs in parallel.
-            let mut worst: Vec<usize> = orders.iter().filter_map(|o| o.first().copied()).collect();
-            worst.sort_unstable();
-            worst.dedup();
-            for view in worst {
-                let camera = &cameras[view];
-                let a = LinearImage::from(&reference_renderer.render(camera, &settings)?);
-                let reference = scorer.prepare(a);
+        // Heat maps and sheets beside the distance searches: both only read what is done.
+        let write_images = || -> Result<()> {
+            if let Some(out_dir) = images
+                && cfg.images.heatmaps == HeatmapChoice::Worst
+            {
+                // Re-render the worst view only, for its heat maps: each distinct worst view's
+                // original once, its LODs in parallel.
+                let mut worst: Vec<usize> =
+                    orders.iter().filter_map(|o| o.first().copied()).collect();
+                worst.sort_unstable();
+                worst.dedup();
+                for view in worst {
+                    let camera = &cameras[view];
+                    let a = LinearImage::from(&reference_renderer.render(camera, &settings)?);
+                    let reference = scorer.prepare(a);
+                    lods.par_iter()
+                        .zip(&lod_renderers)
+                        .zip(&orders)
+                        .filter(|(_, order)| order.first() == Some(&view))
+                        .map(|((lod, lod_renderer), _)| -> Result<()> {
+                            let b = LinearImage::from(&lod_renderer.render(camera, &settings)?);
+                            let scored = scorer.score(&reference, &b)?;
+                            for (metric, map) in &scored.maps {
+                                write_heat_map(out_dir, &asset.name, &lod.name, view, metric, map)?;
+                            }
+                            Ok(())
+                        })
+                        .collect::<Result<()>>()?;
+                }
+            }
+            if let Some(out_dir) = images
+                && cfg.images.contact_sheets
+            {
                 lods.par_iter()
-                    .zip(&lod_renderers)
+                    .zip(&sheets)
                     .zip(&orders)
-                    .filter(|(_, order)| order.first() == Some(&view))
-                    .map(|((lod, lod_renderer), _)| -> Result<()> {
-                        let b = LinearImage::from(&lod_renderer.render(camera, &settings)?);
-                        let scored = scorer.score(&reference, &b)?;
-                        for (metric, map) in &scored.maps {
-                            write_heat_map(out_dir, &asset.name, &lod.name, view, metric, map)?;
+                    .filter(|((_, sheet), _)| !sheet.is_empty())
+                    .map(|((lod, sheet), order)| -> Result<()> {
+                        let mut tiles = Vec::new();
+                        for &v in order.iter().take(cfg.images.sheet_views.max(1)) {
+                            if let Some((_, t)) = sheet.iter().find(|(view, _)| *view == v) {
+                                tiles.extend(t.iter().cloned());
+                            }
                         }
-                        Ok(())
+                        let sheet = raster::contact_sheet(&tiles, 3, 4, [32, 32, 32])?;
+                        crate::io::write_image(
+                            &out_dir
+                                .join("sheets")
+                                .join(&asset.name)
+                                .join(format!("{}.png", lod.name)),
+                            &image::DynamicImage::ImageRgb8(sheet),
+                        )
                     })
                     .collect::<Result<()>>()?;
             }
-        }
-        if let Some(out_dir) = images
-            && cfg.images.contact_sheets
-        {
-            lods.par_iter()
-                .zip(&sheets)
-                .zip(&orders)
-                .filter(|((_, sheet), _)| !sheet.is_empty())
-                .map(|((lod, sheet), order)| -> Result<()> {
-                    let mut tiles = Vec::new();
-                    for &v in order.iter().take(cfg.images.sheet_views.max(1)) {
-                        if let Some((_, t)) = sheet.iter().find(|(view, _)| *view == v) {
-                            tiles.extend(t.iter().cloned());
-                        }
-                    }
-                    let sheet = raster::contact_sheet(&tiles, 3, 4, [32, 32, 32])?;
-                    crate::io::write_image(
-                        &out_dir
-                            .join("sheets")
-                            .join(&asset.name)
-                            .join(format!("{}.png", lod.name)),
-                        &image::DynamicImage::ImageRgb8(sheet),
-                    )
-                })
-                .collect::<Result<()>>()?;
-        }
-        if cfg.distance.enabled {
+            Ok(())
+        };
+        let search_distances = || -> Result<Vec<_>> {
+            if !cfg.distance.enabled {
+                return Ok(Vec::new());
+            }
             // The LODs' searches in parallel, sharing the original's probe renders; rows in LOD
             // order.
             bar.set_message(&format!("{} distances", asset.name));
@@ -354,8 +362,11 @@ pub fn evaluate(
                     rows
                 })
                 .collect::<Result<Vec<_>>>()?;
-            results.distances.extend(rows.into_iter().flatten());
-        }
+            Ok(rows.into_iter().flatten().collect())
+        };
+        let (written, rows) = rayon::join(write_images, search_distances);
+        written?;
+        results.distances.extend(rows?);
         let ext = match cfg.export.gltf {
             GltfExport::None => None,
             GltfExport::Glb => Some("glb"),
