@@ -93,14 +93,25 @@ impl LinearImage {
 
     /// The image as 8-bit sRGB, RGB order (values outside 0..1 clipped), as a PNG stores it.
     pub fn to_srgb8(&self) -> image::RgbImage {
-        let bytes = self
-            .pixels
-            .iter()
-            .flat_map(|c| c.to_array().map(crate::color::linear_to_srgb8))
-            .collect();
-        image::RgbImage::from_raw(self.width as u32, self.height as u32, bytes)
-            .expect("sizes match by construction")
+        srgb8_image(self.width, self.height, &self.pixels)
     }
+}
+
+/// `width` × `height` linear RGB pixels (row-major) as 8-bit sRGB, RGB order, values outside
+/// 0..1 clipped ([`crate::color::linear_to_srgb8`]): the one encoding of every 8-bit output.
+/// Rows are encoded in parallel.
+pub fn srgb8_image(width: usize, height: usize, pixels: &[Vec3]) -> image::RgbImage {
+    use rayon::prelude::*;
+    assert_eq!(pixels.len(), width * height, "one colour per pixel");
+    let mut img = image::RgbImage::new(width as u32, height as u32);
+    img.par_chunks_mut(3 * width.max(1))
+        .zip(pixels.par_chunks(width.max(1)))
+        .for_each(|(bytes, row)| {
+            for (px, c) in bytes.chunks_exact_mut(3).zip(row) {
+                px.copy_from_slice(&c.to_array().map(crate::color::linear_to_srgb8));
+            }
+        });
+    img
 }
 
 /// A per-pixel error, row-major, top row first.

@@ -8,6 +8,8 @@
 //! `psnr_luminance` (dB) and `mse` (linear Rec. 709 luminance), `vdp` (detection probability)
 //! and `vdp_jnd`.
 
+use std::borrow::Cow;
+
 use super::config::MetricFamily;
 use super::tables::round7;
 use crate::error::Result;
@@ -33,8 +35,8 @@ pub struct Reference {
     vdp: Option<VdpPrepared>,
     /// SSIM's channel, for SSIM and MS-SSIM.
     ssim: Option<ssim::SsimPrepared>,
-    /// 8-bit sRGB codes, for PSNR.
-    srgb8: Option<Vec<[u8; 3]>>,
+    /// 8-bit sRGB, for PSNR.
+    srgb8: Option<image::RgbImage>,
 }
 
 /// Scores of one pair: values in metric-name order, and the error maps worth drawing.
@@ -56,23 +58,13 @@ impl Scored {
 }
 
 impl Reference {
-    /// The reference in 8-bit sRGB (what `LinearImage::to_srgb8` gives), from the codes kept for
-    /// PSNR where there are any.
-    pub fn srgb8(&self) -> image::RgbImage {
-        self.srgb8
-            .as_ref()
-            .and_then(|c| rgb_image(self.image.width(), self.image.height(), c))
-            .unwrap_or_else(|| self.image.to_srgb8())
+    /// The reference in 8-bit sRGB, the encoding kept for PSNR where there is one.
+    pub fn srgb8(&self) -> Cow<'_, image::RgbImage> {
+        match &self.srgb8 {
+            Some(rgb) => Cow::Borrowed(rgb),
+            None => Cow::Owned(self.image.to_srgb8()),
+        }
     }
-}
-
-/// An 8-bit RGB image of per-pixel codes.
-fn rgb_image(width: usize, height: usize, codes: &[[u8; 3]]) -> Option<image::RgbImage> {
-    image::RgbImage::from_raw(
-        width as u32,
-        height as u32,
-        codes.iter().flatten().copied().collect(),
-    )
 }
 
 impl Scorer {
@@ -109,9 +101,7 @@ impl Scorer {
                 .then(|| self.vdp.prepare(&image)),
             ssim: (self.has(MetricFamily::Ssim) || self.has(MetricFamily::Msssim))
                 .then(|| ssim::prepare(&image, ssim::SsimInput::SrgbLuma)),
-            srgb8: self
-                .has(MetricFamily::Psnr)
-                .then(|| mse::srgb8_codes(&image)),
+            srgb8: self.has(MetricFamily::Psnr).then(|| image.to_srgb8()),
             image,
         }
     }
@@ -171,10 +161,10 @@ impl Scorer {
                 }
                 MetricFamily::Psnr => {
                     let s = mse::mse(&reference.image, test)?;
-                    let codes = reference.srgb8.as_ref().expect("prepared with PSNR");
-                    let test_codes = mse::srgb8_codes(test);
-                    let rgb = mse::psnr_srgb8_codes(codes, &test_codes, test.width());
-                    out.srgb8 = rgb_image(test.width(), test.height(), &test_codes);
+                    let encoded = reference.srgb8.as_ref().expect("prepared with PSNR");
+                    let test_encoded = test.to_srgb8();
+                    let rgb = mse::psnr_srgb8_encoded(encoded, &test_encoded);
+                    out.srgb8 = Some(test_encoded);
                     out.values.push(("psnr", round7(rgb)));
                     out.values.push(("psnr_luminance", round7(s.psnr_db)));
                     out.values.push(("mse", round7(s.mse)));

@@ -10,22 +10,17 @@
 
 /// Map a value in [0, 1] to an 8-bit sRGB colour of the magma map.
 pub fn magma(v: f32) -> [u8; 3] {
-    let i = (v.clamp(0.0, 1.0) * 255.0 + 0.5) as usize;
-    MAGMA[i.min(255)].map(|c| (c * 255.0 + 0.5) as u8)
+    static TABLE: std::sync::OnceLock<[[u8; 3]; 256]> = std::sync::OnceLock::new();
+    let table = TABLE.get_or_init(|| MAGMA.map(|e| e.map(|c| (c * 255.0 + 0.5) as u8)));
+    table[((v.clamp(0.0, 1.0) * 255.0 + 0.5) as usize).min(255)]
 }
 
 /// An RGB heat map of `values` (row-major, `width` wide) with a `legend`-pixel-high magma strip
 /// from 0 (left) to 1 (right) underneath when `legend > 0`.
 pub fn heat_map(values: &[f32], width: usize, height: usize, legend: usize) -> image::RgbImage {
     let mut img = image::RgbImage::new(width as u32, (height + legend) as u32);
-    let table: Vec<[u8; 3]> = MAGMA
-        .iter()
-        .map(|e| e.map(|c| (c * 255.0 + 0.5) as u8))
-        .collect();
     for (px, &v) in img.as_mut().chunks_exact_mut(3).zip(values) {
-        // The index exactly as `magma` takes it.
-        let i = ((v.clamp(0.0, 1.0) * 255.0 + 0.5) as usize).min(255);
-        px.copy_from_slice(&table[i]);
+        px.copy_from_slice(&magma(v));
     }
     for y in height..height + legend {
         for x in 0..width {

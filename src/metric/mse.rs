@@ -83,42 +83,29 @@ pub fn mse(reference: &LinearImage, test: &LinearImage) -> Result<MseScore> {
 /// 10·log10(255² / MSE) in dB, saturating at [`PSNR_CEILING_DB`] for identical encodings.
 pub fn psnr_srgb8(reference: &LinearImage, test: &LinearImage) -> Result<f64> {
     same_size(reference, test)?;
-    Ok(psnr_srgb8_codes(
-        &srgb8_codes(reference),
-        &srgb8_codes(test),
-        reference.width(),
-    ))
+    Ok(psnr_srgb8_encoded(&reference.to_srgb8(), &test.to_srgb8()))
 }
 
-/// Every pixel's 8-bit sRGB codes (what a PNG stores), for [`psnr_srgb8_codes`].
-pub fn srgb8_codes(image: &LinearImage) -> Vec<[u8; 3]> {
-    image
-        .pixels()
-        .par_iter()
-        .with_min_len(4096)
-        .map(|p| [0, 1, 2].map(|k| crate::color::linear_to_srgb8(p[k])))
-        .collect()
-}
-
-/// [`psnr_srgb8`] of two images' codes ([`srgb8_codes`]; equal lengths, `width` pixels per row).
-pub fn psnr_srgb8_codes(reference: &[[u8; 3]], test: &[[u8; 3]], width: usize) -> f64 {
-    debug_assert_eq!(reference.len(), test.len());
-    let w = width.max(1);
+/// [`psnr_srgb8`] of two images already encoded ([`LinearImage::to_srgb8`]; equal sizes).
+pub fn psnr_srgb8_encoded(reference: &image::RgbImage, test: &image::RgbImage) -> f64 {
+    debug_assert_eq!(reference.dimensions(), test.dimensions());
+    let row = 3 * (reference.width() as usize).max(1);
     let rows: Vec<f64> = reference
-        .par_chunks(w)
-        .zip(test.par_chunks(w))
+        .par_chunks(row)
+        .zip(test.par_chunks(row))
         .map(|(ra, rb)| {
-            let mut s = 0i64;
-            for (p, q) in ra.iter().zip(rb) {
-                for k in 0..3 {
-                    let d = i64::from(p[k]) - i64::from(q[k]);
-                    s += d * d;
-                }
-            }
+            let s: i64 = ra
+                .iter()
+                .zip(rb)
+                .map(|(&p, &q)| {
+                    let d = i64::from(p) - i64::from(q);
+                    d * d
+                })
+                .sum();
             s as f64
         })
         .collect();
-    let mse = rows.iter().sum::<f64>() / (3 * reference.len()).max(1) as f64;
+    let mse = rows.iter().sum::<f64>() / reference.len().max(1) as f64;
     if mse > 0.0 {
         (10.0 * (255.0 * 255.0 / mse).log10()).min(PSNR_CEILING_DB)
     } else {

@@ -3,7 +3,6 @@
 
 use glam::Vec3;
 
-use crate::color::linear_to_srgb8;
 use crate::error::{Error, Result};
 
 /// Triangle id of a pixel no triangle covers.
@@ -65,13 +64,7 @@ impl Frame {
 
     /// The colour as 8-bit sRGB, RGB order (values outside 0..1 are clipped).
     pub fn to_srgb8(&self) -> image::RgbImage {
-        let bytes = self
-            .color
-            .iter()
-            .flat_map(|c| c.to_array().map(linear_to_srgb8))
-            .collect();
-        image::RgbImage::from_raw(self.width, self.height, bytes)
-            .expect("sizes match by construction")
+        crate::image::srgb8_image(self.width as usize, self.height as usize, &self.color)
     }
 
     /// The colour as linear 32-bit float RGB (for EXR output).
