@@ -26,6 +26,7 @@ use super::distance::{self, DistanceJob};
 use super::plan::{AssetPlan, GenTarget, LodSource, Plan, Shard, case_id};
 use super::score::Scorer;
 use super::tables::{LodInfo, MetricRow, Results, higher_is_worse, round7};
+use crate::backend::SceneRenderer;
 use crate::error::Result;
 use crate::mesh::{self, LoadOptions, Mesh, surface_distance};
 use crate::metric::{LinearImage, colormap};
@@ -194,58 +195,48 @@ pub fn evaluate(
         let mut next = (!cameras.is_empty()).then(|| reference_view(0));
         for (v, camera) in cameras.iter().enumerate() {
             let (prepared, ref_thumb) = next.take().expect("prepared ahead")?;
+            // One LOD of this view: rendered, scored, its heat maps written, its sheet tiles.
+            let score_lod = |(lod, lod_renderer): (&LodScene, &SceneRenderer)| -> Result<_> {
+                let test_frame = lod_renderer.render(camera, &settings)?;
+                let scored = scorer.score(&prepared, &LinearImage::from(&test_frame))?;
+                if let Some(out_dir) = images
+                    && cfg.images.heatmaps == HeatmapChoice::All
+                {
+                    for (metric, map) in &scored.maps {
+                        write_heat_map(out_dir, &asset.name, &lod.name, v, metric, map)?;
+                    }
+                }
+                let thumbs = scored.maps.first().map(|(metric, map)| {
+                    let test_rgb8: Cow<image::RgbImage> = match &scored.srgb8 {
+                        Some(rgb) => Cow::Borrowed(rgb),
+                        None => Cow::Owned(test_frame.to_srgb8()),
+                    };
+                    let heat = colormap::heat_map(&map.values, map.width, map.height, 0);
+                    let score = scored
+                        .values
+                        .iter()
+                        .find(|(m, _)| m == metric)
+                        .map_or(String::new(), |(_, x)| format!(" {x:.4}"));
+                    [
+                        captioned(ref_thumb.clone(), &format!("view {v} · original")),
+                        captioned(thumbnail(&test_rgb8), &format!("view {v} · {}", lod.name)),
+                        captioned(
+                            thumbnail(&heat),
+                            &format!("{}{score}", metric.to_uppercase()),
+                        ),
+                    ]
+                });
+                bar.advance(1);
+                Ok((scored.values, thumbs))
+            };
             // The LODs of one view are independent: render and score them in parallel, then
-            // record them in LOD order (outputs never depend on which finished first).
-            // The next view's original is prepared meanwhile, so that no core waits for it.
+            // record them in LOD order (outputs never depend on which finished first). The next
+            // view's original is prepared meanwhile, so that no core waits for it.
             let (per_lod, following) = rayon::join(
                 || {
                     lods.par_iter()
                         .zip(&lod_renderers)
-                        .map(|(lod, lod_renderer)| -> Result<_> {
-                            let test_frame = lod_renderer.render(camera, &settings)?;
-                            let scored =
-                                scorer.score(&prepared, &LinearImage::from(&test_frame))?;
-                            if let Some(out_dir) = images
-                                && cfg.images.heatmaps == HeatmapChoice::All
-                            {
-                                for (metric, map) in &scored.maps {
-                                    write_heat_map(
-                                        out_dir,
-                                        &asset.name,
-                                        &lod.name,
-                                        v,
-                                        metric,
-                                        map,
-                                    )?;
-                                }
-                            }
-                            let thumbs = scored.maps.first().map(|(metric, map)| {
-                                let test_rgb8: Cow<image::RgbImage> = match &scored.srgb8 {
-                                    Some(rgb) => Cow::Borrowed(rgb),
-                                    None => Cow::Owned(test_frame.to_srgb8()),
-                                };
-                                let heat =
-                                    colormap::heat_map(&map.values, map.width, map.height, 0);
-                                let score = scored
-                                    .values
-                                    .iter()
-                                    .find(|(m, _)| m == metric)
-                                    .map_or(String::new(), |(_, x)| format!(" {x:.4}"));
-                                [
-                                    captioned(ref_thumb.clone(), &format!("view {v} · original")),
-                                    captioned(
-                                        thumbnail(&test_rgb8),
-                                        &format!("view {v} · {}", lod.name),
-                                    ),
-                                    captioned(
-                                        thumbnail(&heat),
-                                        &format!("{}{score}", metric.to_uppercase()),
-                                    ),
-                                ]
-                            });
-                            bar.advance(1);
-                            Ok((scored.values, thumbs))
-                        })
+                        .map(score_lod)
                         .collect::<Result<Vec<_>>>()
                 },
                 || (v + 1 < cameras.len()).then(|| reference_view(v + 1)),

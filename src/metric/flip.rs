@@ -367,10 +367,6 @@ impl Flip {
             .into_par_iter()
             .with_min_len(4096)
             .map(|i| {
-                // Equal colour and features: no error (what the formulas below give, exactly).
-                if reference.lab[i] == test.lab[i] && reference.features[i] == test.features[i] {
-                    return 0.0;
-                }
                 // Colour difference, remapped to [0, 1] with the knee at pc·cmax (paper §3.2).
                 let mut dc = hyab(reference.lab[i], test.lab[i]).powf(QC);
                 dc = if dc < pccmax {
