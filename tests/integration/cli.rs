@@ -466,13 +466,10 @@ fn progress_in_a_log_is_a_line_every_few_seconds_and_quiet_silences_it() {
         ),
     )
     .unwrap();
-    let out = std::process::Command::new(env!("CARGO_BIN_EXE_lodeval"))
-        .args(["eval", cfg.to_str().unwrap()])
-        .env("LODEVAL_PROGRESS_EVERY_MS", "0")
-        .output()
-        .unwrap();
-    assert_eq!(out.status.code(), Some(0));
-    let err = String::from_utf8_lossy(&out.stderr);
+    let every = [("LODEVAL_PROGRESS_EVERY_MS", Some("0"))];
+    let r = crate::common::lodeval_env(["eval", cfg.to_str().unwrap()], &every);
+    assert_eq!(r.code, 0, "{}", r.stderr);
+    let err = &r.stderr;
     let lines: Vec<&str> = err.lines().filter(|l| l.contains(" renders")).collect();
     assert!(lines.len() >= 2, "{err}");
     // `[hh:mm:ss] done/total renders  message`, ending at 12/12.
@@ -482,12 +479,8 @@ fn progress_in_a_log_is_a_line_every_few_seconds_and_quiet_silences_it() {
         !err.contains('\r') && !err.contains("\u{1b}["),
         "no terminal control codes: {err}"
     );
-    let quiet = std::process::Command::new(env!("CARGO_BIN_EXE_lodeval"))
-        .args(["eval", cfg.to_str().unwrap(), "--quiet"])
-        .env("LODEVAL_PROGRESS_EVERY_MS", "0")
-        .output()
-        .unwrap();
-    assert!(!String::from_utf8_lossy(&quiet.stderr).contains(" renders"));
+    let quiet = crate::common::lodeval_env(["eval", cfg.to_str().unwrap(), "--quiet"], &every);
+    assert!(!quiet.stderr.contains(" renders"));
 }
 
 #[test]

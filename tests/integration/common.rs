@@ -17,11 +17,24 @@ where
     I: IntoIterator<Item = S>,
     S: AsRef<std::ffi::OsStr>,
 {
-    let out = Command::new(env!("CARGO_BIN_EXE_lodeval"))
-        .args(args)
-        .env_remove("RUST_BACKTRACE")
-        .output()
-        .expect("the lodeval binary runs");
+    lodeval_env(args, &[])
+}
+
+/// [`lodeval`] with environment variables set (`Some`) or removed (`None`).
+pub fn lodeval_env<I, S>(args: I, env: &[(&str, Option<&str>)]) -> Run
+where
+    I: IntoIterator<Item = S>,
+    S: AsRef<std::ffi::OsStr>,
+{
+    let mut cmd = Command::new(env!("CARGO_BIN_EXE_lodeval"));
+    cmd.args(args).env_remove("RUST_BACKTRACE");
+    for (key, value) in env {
+        match value {
+            Some(v) => cmd.env(key, v),
+            None => cmd.env_remove(key),
+        };
+    }
+    let out = cmd.output().expect("the lodeval binary runs");
     Run {
         code: out.status.code().unwrap_or(-1),
         stdout: String::from_utf8_lossy(&out.stdout).into_owned(),

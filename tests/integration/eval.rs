@@ -5,23 +5,11 @@
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-use crate::common::{Run, files, lodeval, model};
+use crate::common::{Run, files, lodeval, lodeval_env, model};
 
 /// Run the CLI with `CI` set or removed.
 fn lodeval_ci(args: &[&str], ci: bool) -> Run {
-    let mut cmd = Command::new(env!("CARGO_BIN_EXE_lodeval"));
-    cmd.args(args).env_remove("RUST_BACKTRACE");
-    if ci {
-        cmd.env("CI", "true");
-    } else {
-        cmd.env_remove("CI");
-    }
-    let out = cmd.output().expect("the lodeval binary runs");
-    Run {
-        code: out.status.code().unwrap_or(-1),
-        stdout: String::from_utf8_lossy(&out.stdout).into_owned(),
-        stderr: String::from_utf8_lossy(&out.stderr).into_owned(),
-    }
+    lodeval_env(args, &[("CI", ci.then_some("true"))])
 }
 
 /// A config in `dir` with small renders; `assets` is TOML for the `[[asset]]` entries.
