@@ -111,7 +111,7 @@ impl DiffMetric {
     /// Whether a larger value means a larger difference (FLIP, MSE, the VDP) rather than a
     /// smaller one (SSIM, MS-SSIM, PSNR).
     pub fn larger_is_worse(self) -> bool {
-        matches!(self, DiffMetric::Flip | DiffMetric::Mse | DiffMetric::Vdp)
+        crate::eval::tables::higher_is_worse(self.name())
     }
 }
 

@@ -97,11 +97,13 @@ fn table(r: &CompareReport) -> String {
                 .iter()
                 .filter(|row| row.metric == *m)
                 .map(|row| row.value);
-            // The worst view in the metric's own direction (lowest SSIM and PSNR).
-            let x = match (label, *m) {
-                ("mean", _) => r.summary.iter().find(|x| x.metric == *m).map(|x| x.mean),
-                (_, "ssim" | "psnr" | "psnr_luminance") => values.reduce(f64::min),
-                _ => values.reduce(f64::max),
+            // The worst view in the metric's own direction (lowest SSIM, MS-SSIM and PSNR).
+            let x = if label == "mean" {
+                r.summary.iter().find(|x| x.metric == *m).map(|x| x.mean)
+            } else if lodeval::eval::tables::higher_is_worse(m) {
+                values.reduce(f64::max)
+            } else {
+                values.reduce(f64::min)
             };
             s.push_str(&x.map_or(format!(" {:>9}", "-"), |x| format!(" {x:>9.4}")));
         }
