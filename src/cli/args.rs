@@ -128,6 +128,15 @@ pub(crate) fn count<T: TryFrom<u64>>(
     }
 }
 
+/// A clap value parser for any finite number (a limit the user sets, such as a gate).
+pub(crate) fn finite(text: &str) -> Result<f64, String> {
+    match text.trim().parse::<f64>() {
+        Ok(v) if v.is_finite() => Ok(v),
+        Ok(_) => Err(format!("'{text}': give a finite number")),
+        Err(_) => Err(format!("'{text}' is not a number")),
+    }
+}
+
 /// A clap value parser for a number within `bound` (a `lodeval::limits` bound).
 pub(crate) fn value(
     bound: &'static Bound<f64>,

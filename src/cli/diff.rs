@@ -95,20 +95,20 @@ pub(crate) struct DiffArgs {
     /// Fail (exit 1) when the gated metric's pooled value is worse than this (above it for
     /// flip, mse and vdp; below it for ssim, msssim and psnr). The gated metric is --metric's
     /// (flip for `all`).
-    #[arg(long)]
+    #[arg(long, value_parser = super::args::finite)]
     pub(crate) fail: Option<f64>,
     /// Warn (exit 0, a warning line) when the pooled value is worse than this.
-    #[arg(long)]
+    #[arg(long, value_parser = super::args::finite)]
     pub(crate) warn: Option<f64>,
     /// Fail when more than this percentage of pixels exceed --fail-pixel on the gated metric's
     /// map (FLIP error, 1 − SSIM, or the VDP's detection probability).
-    #[arg(long, requires = "fail_pixel")]
+    #[arg(long, requires = "fail_pixel", value_parser = super::args::finite)]
     pub(crate) fail_percent: Option<f64>,
     /// Warn when more than this percentage of pixels exceed --fail-pixel.
-    #[arg(long, requires = "fail_pixel")]
+    #[arg(long, requires = "fail_pixel", value_parser = super::args::finite)]
     pub(crate) warn_percent: Option<f64>,
     /// The per-pixel threshold of --fail-percent and --warn-percent, in the map's units (0–1).
-    #[arg(long)]
+    #[arg(long, value_parser = super::args::finite)]
     pub(crate) fail_pixel: Option<f64>,
     /// HDR-FLIP (two EXR images): the shortest exposure, in stops (with --stop-exposure and
     /// --num-exposures; default: NVIDIA's automatic range from the reference's peak and median).
@@ -188,17 +188,6 @@ pub(crate) fn run(a: DiffArgs) -> Result<(), Error> {
         warn_percent: a.warn_percent,
         pixel: a.fail_pixel,
     };
-    for (flag, v) in [
-        ("--fail", a.fail),
-        ("--warn", a.warn),
-        ("--fail-percent", a.fail_percent),
-        ("--warn-percent", a.warn_percent),
-        ("--fail-pixel", a.fail_pixel),
-    ] {
-        if v.is_some_and(|v| !v.is_finite()) {
-            return Err(Error::Usage(format!("{flag}: give a finite number")));
-        }
-    }
     let gated = metrics[0];
     if (a.fail_percent.is_some() || a.warn_percent.is_some())
         && !matches!(gated, DiffMetric::Flip | DiffMetric::Ssim | DiffMetric::Vdp)

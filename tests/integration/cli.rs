@@ -360,6 +360,16 @@ fn diff_gates_grade_exit_codes_and_report_the_worst_pixel() {
         "0.1",
     ]);
     assert_eq!(bad.code, 2, "{}", bad.stderr);
+    // A gate must be a finite number.
+    for (flag, v) in [("--fail", "nan"), ("--fail-pixel", "inf")] {
+        let bad = run(&[flag, v, "--fail-percent", "1"]);
+        assert_eq!(bad.code, 2, "{}", bad.stderr);
+        assert!(
+            bad.stderr.contains(flag) && bad.stderr.contains("finite"),
+            "{}",
+            bad.stderr
+        );
+    }
     // Several test images in one call, with CSV: the identical one passes, the other fails.
     let csv = dir.path().join("d.csv");
     let many = lodeval([
