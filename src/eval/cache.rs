@@ -101,9 +101,18 @@ impl RenderCache {
         camera: &Camera,
         renderer: &str,
     ) -> Option<Vec<Vec3>> {
-        let bytes = std::fs::read(self.path(scene, settings, camera, renderer)).ok()?;
         let n = (settings.width as usize).checked_mul(settings.height as usize)?;
-        if bytes.len() != 8 + n * 12 || &bytes[..8] != MAGIC {
+        let size = n.checked_mul(12)?.checked_add(8)?;
+        // Through the bounded reader of regular files: a planted FIFO or an oversized file is a
+        // miss, never a hang or an unbounded read.
+        let bytes = crate::io::read_input(
+            &self.path(scene, settings, camera, renderer),
+            "render cache entry",
+            size as u64,
+            "delete the cache folder",
+        )
+        .ok()?;
+        if bytes.len() != size || &bytes[..8] != MAGIC {
             return None;
         }
         let f = |i: usize| f32::from_le_bytes(bytes[i..i + 4].try_into().unwrap_or([0; 4]));

@@ -754,6 +754,27 @@ fn the_render_cache_gives_the_same_bytes_and_renders_originals_once() {
     run("repaired", true);
     assert_same_tree(&out("plain"), &out("repaired"));
     assert!(std::fs::metadata(cache.join(&first)).unwrap().len() > 1000);
+    // An entry that is a FIFO is a miss too, not a hang (the bounded reader of regular files).
+    let entry = cache.join(&first);
+    std::fs::remove_file(&entry).unwrap();
+    crate::hostile::files::fifo(
+        entry.parent().unwrap(),
+        entry.file_name().unwrap().to_str().unwrap(),
+    );
+    let o = out("fifo");
+    let r = crate::common::lodeval_within(
+        60,
+        [
+            "eval",
+            c,
+            "--out",
+            o.to_str().unwrap(),
+            "--cache",
+            cache.to_str().unwrap(),
+        ],
+    );
+    assert_eq!(r.code, 0, "{}", r.stderr);
+    assert_same_tree(&out("plain"), &o);
     // Another image size is another set of frames.
     let cfg2 = dir.path().join("c2.toml");
     std::fs::write(

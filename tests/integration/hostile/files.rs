@@ -12,7 +12,7 @@ use super::{assert_refused, scratch, write};
 use crate::common::lodeval_within;
 
 /// A FIFO at `dir/name` (nothing ever writes to it: opening it for reading blocks).
-fn fifo(dir: &Path, name: &str) -> PathBuf {
+pub(crate) fn fifo(dir: &Path, name: &str) -> PathBuf {
     let p = dir.join(name);
     let ok = std::process::Command::new("mkfifo")
         .arg(&p)

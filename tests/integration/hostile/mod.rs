@@ -29,7 +29,7 @@
 mod baseline;
 mod bounds;
 mod distances;
-mod files;
+pub mod files;
 pub mod gltf;
 mod goals;
 mod messages;
