@@ -198,23 +198,11 @@ pub fn simplify(
 
 /// A LOD's name in a glTF chain: the method and the goal (`qem-r50`, `meshopt-t1000`).
 fn goal_name(method: crate::simplify::Method, goal: &crate::simplify::Goal) -> String {
-    let stem = PathBuf::from(format!("{}.obj", method.name()));
-    let probe = SimplifyJob {
-        mesh: PathBuf::new(),
-        out: stem,
-        method,
-        goals: Vec::new(),
-        chain: true,
-        meters_per_unit: 1.0,
-    };
-    lod_file(&probe, goal).file_stem().map_or_else(
-        || method.name().to_string(),
-        |s| s.to_string_lossy().into_owned(),
-    )
+    format!("{}-{}", method.name(), goal_suffix(goal))
 }
 
-/// The file a LOD of `goal` goes to: `out` itself, or in a chain `STEM-r50.obj`, `STEM-t1000.obj`,
-/// `STEM-e0.01.obj` beside it.
+/// The file a LOD of `goal` goes to: `-o` itself, or in a chain `STEM-SUFFIX.obj` beside it (the
+/// suffix from [`goal_suffix`]).
 fn lod_file(job: &SimplifyJob, goal: &crate::simplify::Goal) -> PathBuf {
     if !job.chain {
         return job.out.clone();
@@ -223,7 +211,13 @@ fn lod_file(job: &SimplifyJob, goal: &crate::simplify::Goal) -> PathBuf {
         .out
         .file_stem()
         .map_or_else(|| "lod".into(), |s| s.to_string_lossy().into_owned());
-    let suffix = match goal {
+    job.out
+        .with_file_name(format!("{stem}-{}.obj", goal_suffix(goal)))
+}
+
+/// A goal in a name: `r50` (ratio in percent), `t1000`, `e0.01`, `d5`, `v2000`.
+fn goal_suffix(goal: &crate::simplify::Goal) -> String {
+    match goal {
         crate::simplify::Goal::Ratio(r) => {
             format!("r{}", crate::eval::config::percent_label(*r))
         }
@@ -231,8 +225,7 @@ fn lod_file(job: &SimplifyJob, goal: &crate::simplify::Goal) -> PathBuf {
         crate::simplify::Goal::Error(e) => format!("e{e}"),
         crate::simplify::Goal::Distance(d) => format!("d{d}"),
         crate::simplify::Goal::Vertices(v) => format!("v{v}"),
-    };
-    job.out.with_file_name(format!("{stem}-{suffix}.obj"))
+    }
 }
 
 /// Which views a Williams et al. LOD is made for.
