@@ -19,6 +19,8 @@ use super::setup::{Corners, SetupOut, SetupTri, Viewport, XfVertex, setup_one};
 
 /// Tile edge in pixels.
 pub const TILE: u32 = 64;
+/// How many triangles ahead [`Binned::tile`] asks for a record.
+const LOOKAHEAD: usize = 4;
 /// Source triangles per set-up chunk.
 const CHUNK: usize = 4096;
 
@@ -69,12 +71,20 @@ impl Binned {
     }
 
     /// The set-up triangles touching tile `t`, as (id, triangle), in source-triangle order.
+    ///
+    /// Each triangle's record is asked for a few triangles ahead ([`LOOKAHEAD`]): the records of
+    /// a frame (64 bytes per triangle) are far larger than the caches, and a tile reads them
+    /// scattered over every chunk, so waiting for each one was a visible share of the scan.
     pub fn tile(&self, t: usize) -> impl Iterator<Item = (u32, &SetupTri)> {
         self.chunks.iter().enumerate().flat_map(move |(c, chunk)| {
             let range = chunk.tile_start[t] as usize..chunk.tile_start[t + 1] as usize;
-            chunk.items[range]
-                .iter()
-                .map(move |&k| (((c as u32) << 16) | k as u32, &chunk.tris[k as usize]))
+            let items = &chunk.items[range];
+            items.iter().enumerate().map(move |(j, &k)| {
+                if let Some(&ahead) = items.get(j + LOOKAHEAD) {
+                    crate::prefetch::prefetch(&chunk.tris[ahead as usize]);
+                }
+                (((c as u32) << 16) | k as u32, &chunk.tris[k as usize])
+            })
         })
     }
 }

@@ -5,7 +5,8 @@
 //!    (`fixed.rs`), orient every triangle; parallel over fixed chunks, concatenated in order.
 //! 2. `bin.rs` — bin set-up triangles into 64×64-pixel tiles, each list in triangle order.
 //! 3. `edge.rs` — per tile, in parallel: scan-convert its triangles into per-sample depth and
-//!    triangle-id buffers (a visibility buffer) with integer edge functions and the top-left rule.
+//!    triangle-id buffers (a visibility buffer) with integer edge functions and the top-left rule;
+//!    small triangles at 4 samples per pixel in 32-bit vector lanes.
 //! 4. `resolve.rs` — per pixel: shade (`shade.rs`, textures from `texture.rs`) once per distinct
 //!    triangle among its samples, at that triangle's first covered sample, and average the samples in
 //!    linear light.
