@@ -461,7 +461,7 @@ mod avx2 {
         rect: [i32; 4],
         buf: &mut TileSamples,
     ) {
-        let one = super::super::fixed::ONE_PIXEL as i32;
+        let one = crate::raster::fixed::ONE_PIXEL as i32;
         let p = st.v;
         // Edge i: from p[i+1] to p[i+2]; E = −d.y·(x − a.x) + d.x·(y − a.y) (`edges_at`), in i32:
         // `small` bounds every value (see there).
@@ -504,7 +504,7 @@ mod avx2 {
         offsets: &[[i64; 2]],
         buf: &mut TileSamples,
     ) {
-        let one = super::super::fixed::ONE_PIXEL as i32;
+        let one = crate::raster::fixed::ONE_PIXEL as i32;
         let ox = _mm_setr_epi32(
             offsets[0][0] as i32,
             offsets[1][0] as i32,
