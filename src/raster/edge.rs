@@ -39,14 +39,20 @@ pub(crate) struct TileSamples {
 /// Marker for an uncovered sample.
 pub(crate) const EMPTY: u32 = u32::MAX;
 
+/// Spare entries after a tile's last sample: the vector scan reads and writes two pixels' samples
+/// at once, and on a row's last pixel the second pair of four lies past it (it writes back what it
+/// read there; plain loads and stores are much faster than masked ones).
+const PAD: usize = 4;
+
 impl TileSamples {
     pub fn new(rect: [i32; 4], samples: usize, count_coverage: bool) -> TileSamples {
         let n = ((rect[2] - rect[0]) * (rect[3] - rect[1])) as usize * samples;
         TileSamples {
             rect,
             samples,
-            depth: vec![f32::INFINITY; n],
-            ids: vec![EMPTY; n],
+            // `PAD` spare entries after the last sample, never covered.
+            depth: vec![f32::INFINITY; n + PAD],
+            ids: vec![EMPTY; n + PAD],
             counts: count_coverage.then(|| vec![0; n]),
         }
     }
@@ -351,13 +357,21 @@ fn scan<const S: usize, const COUNT: bool>(
     });
 }
 
-/// The scans of [`Small`] triangles, four lanes at a time: coverage in 32-bit integer lanes,
-/// depth in 64-bit float lanes with the scalar scans' operations in their order (so the same
-/// bits), and a branch-free depth test by blending.
+/// The vector scan of [`small`] triangles at four samples per pixel: two pixels' samples (eight
+/// 32-bit lanes) per step, coverage in one compare, depths in 64-bit float lanes with the scalar
+/// scan's operations in its order (so the same bits), and a branch-free depth test by blending.
 #[cfg(all(target_arch = "x86_64", target_feature = "avx2"))]
 mod avx2 {
     use super::{SetupTri, TileSamples};
     use std::arch::x86_64::*;
+
+    /// A small triangle's edge functions in 32 bits: value at the first pixel's corner
+    /// (unbiased), x and y coefficients, top-left bias.
+    struct Edges32 {
+        origin: [i32; 3],
+        coef: [[i32; 2]; 3],
+        bias: [i32; 3],
+    }
 
     /// Per-triangle constants of the depth lanes: the corner depths and 1/area.
     struct Depth {
@@ -381,7 +395,7 @@ mod avx2 {
         /// NDC depth of four lanes with unbiased edge values `w` (as `interpolated_depth`).
         #[inline]
         #[target_feature(enable = "avx2")]
-        fn at(&self, w: [__m128i; 3]) -> __m128 {
+        fn four(&self, w: [__m128i; 3]) -> __m128 {
             let [w0, w1, w2] = [
                 _mm256_cvtepi32_pd(w[0]),
                 _mm256_cvtepi32_pd(w[1]),
@@ -393,39 +407,56 @@ mod avx2 {
             );
             _mm256_cvtpd_ps(_mm256_mul_pd(sum, self.inv_area))
         }
+
+        /// NDC depth of eight lanes.
+        #[inline]
+        #[target_feature(enable = "avx2")]
+        fn eight(&self, w: [__m256i; 3]) -> __m256 {
+            let low = self.four([
+                _mm256_castsi256_si128(w[0]),
+                _mm256_castsi256_si128(w[1]),
+                _mm256_castsi256_si128(w[2]),
+            ]);
+            let high = self.four([
+                _mm256_extracti128_si256::<1>(w[0]),
+                _mm256_extracti128_si256::<1>(w[1]),
+                _mm256_extracti128_si256::<1>(w[2]),
+            ]);
+            _mm256_set_m128(high, low)
+        }
     }
 
-    /// Each of three values in all four lanes. (Written out: closures in a `target_feature`
-    /// function are compiled without its features and were called out of line.)
+    /// Lane-wise `a + b` of three edges. (Helpers like this are written out: closures in a
+    /// `target_feature` function are compiled without its features and were called out of line.)
     #[inline]
     #[target_feature(enable = "avx2")]
-    fn splat(v: [i32; 3]) -> [__m128i; 3] {
+    fn add(a: [__m256i; 3], b: [__m256i; 3]) -> [__m256i; 3] {
         [
-            _mm_set1_epi32(v[0]),
-            _mm_set1_epi32(v[1]),
-            _mm_set1_epi32(v[2]),
-        ]
-    }
-
-    /// Lane-wise `a + b` of three edges.
-    #[inline]
-    #[target_feature(enable = "avx2")]
-    fn add(a: [__m128i; 3], b: [__m128i; 3]) -> [__m128i; 3] {
-        [
-            _mm_add_epi32(a[0], b[0]),
-            _mm_add_epi32(a[1], b[1]),
-            _mm_add_epi32(a[2], b[2]),
+            _mm256_add_epi32(a[0], b[0]),
+            _mm256_add_epi32(a[1], b[1]),
+            _mm256_add_epi32(a[2], b[2]),
         ]
     }
 
     /// Lane-wise `a − b` of three edges.
     #[inline]
     #[target_feature(enable = "avx2")]
-    fn sub(a: [__m128i; 3], b: [__m128i; 3]) -> [__m128i; 3] {
+    fn sub(a: [__m256i; 3], b: [__m256i; 3]) -> [__m256i; 3] {
         [
-            _mm_sub_epi32(a[0], b[0]),
-            _mm_sub_epi32(a[1], b[1]),
-            _mm_sub_epi32(a[2], b[2]),
+            _mm256_sub_epi32(a[0], b[0]),
+            _mm256_sub_epi32(a[1], b[1]),
+            _mm256_sub_epi32(a[2], b[2]),
+        ]
+    }
+
+    /// Each of three values in all lanes.
+    #[inline]
+    #[target_feature(enable = "avx2")]
+    fn splat(v: [i32; 3]) -> [__m256i; 3] {
+        [
+            _mm256_set1_epi32(v[0]),
+            _mm256_set1_epi32(v[1]),
+            _mm256_set1_epi32(v[2]),
         ]
     }
 
@@ -433,18 +464,10 @@ mod avx2 {
     /// loaded from would otherwise become a masked store (`vmaskmovps`), which is several times
     /// slower on AMD cores than a load, a blend and a store.
     #[inline(always)]
-    fn opaque(mut v: __m128) -> __m128 {
+    fn opaque(mut v: __m256) -> __m256 {
         // SAFETY: an empty instruction sequence that only claims to change the register.
-        unsafe { std::arch::asm!("/* {0} */", inout(xmm_reg) v, options(pure, nomem, nostack)) };
+        unsafe { std::arch::asm!("/* {0} */", inout(ymm_reg) v, options(pure, nomem, nostack)) };
         v
-    }
-
-    /// Lanes whose three edge values are all ≥ 0 (all ones there, zero elsewhere).
-    #[inline]
-    #[target_feature(enable = "avx2")]
-    fn inside(e: [__m128i; 3]) -> __m128i {
-        let any = _mm_or_si128(_mm_or_si128(e[0], e[1]), e[2]);
-        _mm_cmpgt_epi32(any, _mm_set1_epi32(-1))
     }
 
     /// [`super::rasterize`] for a [`super::small`] triangle at four samples per pixel, in 32-bit
@@ -482,16 +505,8 @@ mod avx2 {
         unsafe { scan_four(st, id, rect, &edges, offsets, buf) }
     }
 
-    /// A small triangle's edge functions in 32 bits: value at the first pixel's corner
-    /// (unbiased), x and y coefficients, top-left bias.
-    struct Edges32 {
-        origin: [i32; 3],
-        coef: [[i32; 2]; 3],
-        bias: [i32; 3],
-    }
-
-    /// Four samples per pixel at `offsets`: a pixel's four samples at a time, with a vector
-    /// compare, and a depth only where one of them is covered.
+    /// Four samples per pixel at `offsets`, two pixels of a row (eight samples, contiguous in
+    /// the buffer) per step; a depth only where one of them is covered.
     ///
     /// # Safety
     /// As [`rasterize_small`].
@@ -505,62 +520,85 @@ mod avx2 {
         buf: &mut TileSamples,
     ) {
         let one = crate::raster::fixed::ONE_PIXEL as i32;
-        let ox = _mm_setr_epi32(
-            offsets[0][0] as i32,
-            offsets[1][0] as i32,
-            offsets[2][0] as i32,
-            offsets[3][0] as i32,
+        let o = |k: usize, c: usize| offsets[k][c] as i32;
+        // Sample k of lanes 0–3 (the first pixel) and 4–7 (the one to its right).
+        let ox = _mm256_setr_epi32(
+            o(0, 0),
+            o(1, 0),
+            o(2, 0),
+            o(3, 0),
+            o(0, 0) + one,
+            o(1, 0) + one,
+            o(2, 0) + one,
+            o(3, 0) + one,
         );
-        let oy = _mm_setr_epi32(
-            offsets[0][1] as i32,
-            offsets[1][1] as i32,
-            offsets[2][1] as i32,
-            offsets[3][1] as i32,
+        let oy = _mm256_setr_epi32(
+            o(0, 1),
+            o(1, 1),
+            o(2, 1),
+            o(3, 1),
+            o(0, 1),
+            o(1, 1),
+            o(2, 1),
+            o(3, 1),
         );
-        // Per-sample offsets of each edge value from the pixel corner, bias folded in.
-        let mut so = [_mm_setzero_si128(); 3];
+        // Each lane's offset of each edge value from the first pixel's corner, bias folded in.
+        let mut so = [_mm256_setzero_si256(); 3];
         for (i, so) in so.iter_mut().enumerate() {
             let [cx, cy] = edges.coef[i];
-            *so = _mm_add_epi32(
-                _mm_add_epi32(
-                    _mm_mullo_epi32(_mm_set1_epi32(cx), ox),
-                    _mm_mullo_epi32(_mm_set1_epi32(cy), oy),
+            *so = _mm256_add_epi32(
+                _mm256_add_epi32(
+                    _mm256_mullo_epi32(_mm256_set1_epi32(cx), ox),
+                    _mm256_mullo_epi32(_mm256_set1_epi32(cy), oy),
                 ),
-                _mm_set1_epi32(edges.bias[i]),
+                _mm256_set1_epi32(edges.bias[i]),
             );
         }
-        let step_x = edges.coef.map(|c| c[0] * one);
-        let step_y = edges.coef.map(|c| c[1] * one);
+        let step_x = [0, 1, 2].map(|i| edges.coef[i][0] * one);
+        let step_y = [0, 1, 2].map(|i| edges.coef[i][1] * one);
         let tile = buf.rect;
         let tile_w = (tile[2] - tile[0]) as usize;
         let bias = splat(edges.bias);
-        let ids = _mm_castsi128_ps(_mm_set1_epi32(id as i32));
+        let ids = _mm256_castsi256_ps(_mm256_set1_epi32(id as i32));
+        // Lanes of the second pixel, to mask when the row ends after the first.
+        let second = _mm256_setr_epi32(0, 0, 0, 0, -1, -1, -1, -1);
         let depth = Depth::of(st);
         let mut row = edges.origin;
         for y in y0..y1 {
             let base_y = (y - tile[1]) as usize * tile_w;
             let mut e = row;
-            for x in x0..x1 {
+            let mut x = x0;
+            while x < x1 {
                 let v = add(splat(e), so);
-                let covered = inside(v);
-                if _mm_movemask_ps(_mm_castsi128_ps(covered)) != 0 {
-                    let z = depth.at(sub(v, bias));
+                let any = _mm256_or_si256(_mm256_or_si256(v[0], v[1]), v[2]);
+                let mut covered = _mm256_cmpgt_epi32(any, _mm256_set1_epi32(-1));
+                if x + 1 == x1 {
+                    covered = _mm256_andnot_si256(second, covered);
+                }
+                if _mm256_movemask_ps(_mm256_castsi256_ps(covered)) != 0 {
+                    let z = depth.eight(sub(v, bias));
                     let slot = (base_y + (x - tile[0]) as usize) * 4;
-                    assert!(slot + 4 <= buf.depth.len() && slot + 4 <= buf.ids.len());
-                    // SAFETY: the four samples of a pixel of `rect`, within the tile's buffers.
+                    assert!(slot + 8 <= buf.depth.len() && slot + 8 <= buf.ids.len());
+                    // SAFETY: eight entries from the first sample of a pixel of `rect`, in
+                    // bounds (asserted: a tile's buffers have `PAD` spare entries). Lanes past
+                    // the row's end are not covered and get back the values read from them.
                     unsafe {
                         let dp = buf.depth.as_mut_ptr().add(slot);
                         let ip = buf.ids.as_mut_ptr().add(slot).cast::<f32>();
-                        let old = opaque(_mm_loadu_ps(dp));
-                        let keep =
-                            _mm_and_ps(_mm_cmp_ps::<_CMP_LT_OQ>(z, old), _mm_castsi128_ps(covered));
-                        _mm_storeu_ps(dp, _mm_blendv_ps(old, z, keep));
-                        _mm_storeu_ps(ip, _mm_blendv_ps(opaque(_mm_loadu_ps(ip)), ids, keep));
+                        let old = opaque(_mm256_loadu_ps(dp));
+                        let keep = _mm256_and_ps(
+                            _mm256_cmp_ps::<_CMP_LT_OQ>(z, old),
+                            _mm256_castsi256_ps(covered),
+                        );
+                        _mm256_storeu_ps(dp, _mm256_blendv_ps(old, z, keep));
+                        let old_ids = opaque(_mm256_loadu_ps(ip));
+                        _mm256_storeu_ps(ip, _mm256_blendv_ps(old_ids, ids, keep));
                     }
                 }
                 for i in 0..3 {
-                    e[i] += step_x[i];
+                    e[i] += 2 * step_x[i];
                 }
+                x += 2;
             }
             for i in 0..3 {
                 row[i] += step_y[i];
