@@ -58,6 +58,16 @@ impl TileSamples {
     }
 }
 
+/// Which scans [`rasterize`] may use.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Scans {
+    /// The vector scan for small triangles where the build has one (what renders use).
+    Fastest,
+    /// The 64-bit scalar scans only (the tests' reference: the same coverage and depths).
+    #[cfg_attr(not(test), allow(dead_code))]
+    Scalar,
+}
+
 /// Rasterize set-up triangle `st` (index `id`) into `buf`, restricted to `clip` (a sub-rectangle
 /// of the tile, `[x0, y0, x1, y1)`). `offsets` are the sample positions within a pixel in Fx24_8.
 /// `scratch` must hold at least `offsets.len()` entries.
@@ -68,20 +78,7 @@ pub(crate) fn rasterize(
     clip: [i32; 4],
     buf: &mut TileSamples,
     scratch: &mut [[i64; 3]],
-) {
-    scan_triangle(st, id, offsets, clip, buf, scratch, true);
-}
-
-/// [`rasterize`], with the vector scans of small triangles on (`vector`) or off (the tests'
-/// reference: the same coverage and depths from the 64-bit scalar scans).
-fn scan_triangle(
-    st: &SetupTri,
-    id: u32,
-    offsets: &[[i64; 2]],
-    clip: [i32; 4],
-    buf: &mut TileSamples,
-    scratch: &mut [[i64; 3]],
-    vector: bool,
+    scans: Scans,
 ) {
     let bbox = st.bbox();
     let x0 = bbox[0].max(clip[0]);
@@ -94,13 +91,12 @@ fn scan_triangle(
     let rect = [x0, y0, x1, y1];
     let s = offsets.len();
     #[cfg(all(target_arch = "x86_64", target_feature = "avx2"))]
-    if vector && s == 4 && buf.counts.is_none() && small(st) {
+    if scans == Scans::Fastest && s == 4 && buf.counts.is_none() && small(st) {
         // SAFETY: this build targets AVX2 (cfg); the triangle is small (`small`), and `rect`
         // lies within the tile's rectangle, `buf.rect`.
         unsafe { avx2::rasterize_small(st, id, offsets, rect, buf) };
         return;
     }
-    let _ = vector;
     let Edges { origin, coef, bias } = edges_at(st, x0, y0);
     if s == 1 && buf.counts.is_none() {
         // One sample per pixel (a dense mesh's triangles cover a pixel or two): the sample offset
@@ -438,17 +434,6 @@ mod avx2 {
         ]
     }
 
-    /// Lane-wise `a − b` of three edges.
-    #[inline]
-    #[target_feature(enable = "avx2")]
-    fn sub(a: [__m256i; 3], b: [__m256i; 3]) -> [__m256i; 3] {
-        [
-            _mm256_sub_epi32(a[0], b[0]),
-            _mm256_sub_epi32(a[1], b[1]),
-            _mm256_sub_epi32(a[2], b[2]),
-        ]
-    }
-
     /// Each of three values in all lanes.
     #[inline]
     #[target_feature(enable = "avx2")]
@@ -542,23 +527,21 @@ mod avx2 {
             o(2, 1),
             o(3, 1),
         );
-        // Each lane's offset of each edge value from the first pixel's corner, bias folded in.
-        let mut so = [_mm256_setzero_si256(); 3];
-        for (i, so) in so.iter_mut().enumerate() {
+        // Each lane's offset of each edge value from the first pixel's corner: unbiased (for the
+        // depth's weights) and with the top-left bias folded in (for the coverage test).
+        let mut weight_off = [_mm256_setzero_si256(); 3];
+        for (i, w) in weight_off.iter_mut().enumerate() {
             let [cx, cy] = edges.coef[i];
-            *so = _mm256_add_epi32(
-                _mm256_add_epi32(
-                    _mm256_mullo_epi32(_mm256_set1_epi32(cx), ox),
-                    _mm256_mullo_epi32(_mm256_set1_epi32(cy), oy),
-                ),
-                _mm256_set1_epi32(edges.bias[i]),
+            *w = _mm256_add_epi32(
+                _mm256_mullo_epi32(_mm256_set1_epi32(cx), ox),
+                _mm256_mullo_epi32(_mm256_set1_epi32(cy), oy),
             );
         }
+        let so = add(weight_off, splat(edges.bias));
         let step_x = [0, 1, 2].map(|i| edges.coef[i][0] * one);
         let step_y = [0, 1, 2].map(|i| edges.coef[i][1] * one);
         let tile = buf.rect;
         let tile_w = (tile[2] - tile[0]) as usize;
-        let bias = splat(edges.bias);
         let ids = _mm256_castsi256_ps(_mm256_set1_epi32(id as i32));
         // Lanes of the second pixel, to mask when the row ends after the first.
         let second = _mm256_setr_epi32(0, 0, 0, 0, -1, -1, -1, -1);
@@ -569,14 +552,15 @@ mod avx2 {
             let mut e = row;
             let mut x = x0;
             while x < x1 {
-                let v = add(splat(e), so);
+                let at = splat(e);
+                let v = add(at, so);
                 let any = _mm256_or_si256(_mm256_or_si256(v[0], v[1]), v[2]);
                 let mut covered = _mm256_cmpgt_epi32(any, _mm256_set1_epi32(-1));
                 if x + 1 == x1 {
                     covered = _mm256_andnot_si256(second, covered);
                 }
                 if _mm256_movemask_ps(_mm256_castsi256_ps(covered)) != 0 {
-                    let z = depth.eight(sub(v, bias));
+                    let z = depth.eight(add(at, weight_off));
                     let slot = (base_y + (x - tile[0]) as usize) * 4;
                     assert!(slot + 8 <= buf.depth.len() && slot + 8 <= buf.ids.len());
                     // SAFETY: eight entries from the first sample of a pixel of `rect`, in
@@ -676,8 +660,24 @@ mod tests {
                 continue;
             };
             small_ones += small(&st) as u32;
-            scan_triangle(&st, id, &offsets, rect, &mut on, &mut scratch, true);
-            scan_triangle(&st, id, &offsets, rect, &mut off, &mut scratch, false);
+            rasterize(
+                &st,
+                id,
+                &offsets,
+                rect,
+                &mut on,
+                &mut scratch,
+                Scans::Fastest,
+            );
+            rasterize(
+                &st,
+                id,
+                &offsets,
+                rect,
+                &mut off,
+                &mut scratch,
+                Scans::Scalar,
+            );
         }
         for (k, (a, b)) in on.depth.iter().zip(&off.depth).enumerate() {
             assert_eq!(
@@ -740,7 +740,15 @@ mod tests {
             if clip == [0, 0, w as i32, h as i32] {
                 let mut buf = TileSamples::new(clip, 1, false);
                 let half = crate::raster::fixed::ONE_PIXEL / 2;
-                rasterize(&st, 7, &[[half, half]], clip, &mut buf, &mut [[0; 3]; 1]);
+                rasterize(
+                    &st,
+                    7,
+                    &[[half, half]],
+                    clip,
+                    &mut buf,
+                    &mut [[0; 3]; 1],
+                    Scans::Fastest,
+                );
                 let tile: Vec<(i32, i32, u32)> = (0..(w * h) as usize)
                     .filter(|&i| buf.ids[i] == 7)
                     .map(|i| {

@@ -245,7 +245,15 @@ impl Pass {
         let mut buf = TileSamples::new(rect, self.offsets.len(), self.count_coverage);
         let mut scratch = vec![[0i64; 3]; self.offsets.len()];
         for (id, tri) in self.binned.tile(t) {
-            edge::rasterize(tri, id, &self.offsets, rect, &mut buf, &mut scratch);
+            edge::rasterize(
+                tri,
+                id,
+                &self.offsets,
+                rect,
+                &mut buf,
+                &mut scratch,
+                edge::Scans::Fastest,
+            );
         }
         buf
     }
