@@ -97,6 +97,9 @@ pub(crate) fn rasterize(
         unsafe { avx2::rasterize_small(st, id, offsets, rect, buf) };
         return;
     }
+    // Builds without AVX2 have only the scalar scans.
+    #[cfg(not(all(target_arch = "x86_64", target_feature = "avx2")))]
+    let _ = scans;
     let Edges { origin, coef, bias } = edges_at(st, x0, y0);
     if s == 1 && buf.counts.is_none() {
         // One sample per pixel (a dense mesh's triangles cover a pixel or two): the sample offset
