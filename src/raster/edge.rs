@@ -14,10 +14,10 @@
 //! E_i / area is also the barycentric weight of corner i, which gives the depth.
 //!
 //! At four samples per pixel a small triangle (corners within 16 pixels along each axis: every
-//! triangle of a dense mesh) takes a vector scan (`avx2`): its edge values fit in 32 bits, so a
-//! pixel's four samples are tested in one compare and their depths computed in four 64-bit float
-//! lanes with the scalar scan's operations in the scalar scan's order, which keeps every depth bit
-//! and id the same (tested against the scalar scan).
+//! triangle of a dense mesh) takes a vector scan (`avx2`): its edge values fit in 32 bits, so two
+//! pixels' eight samples are tested in one compare and their depths computed in 64-bit float lanes
+//! with the scalar scan's operations in the scalar scan's order, which keeps every depth bit and id
+//! the same (tested against the scalar scan).
 
 use super::setup::SetupTri;
 
@@ -244,9 +244,9 @@ const SMALL_EXTENT: i32 = 16 << super::fixed::SUBPIXEL_BITS;
 
 /// Whether `st` is small enough for the 32-bit vector scan: its corners span at most
 /// [`SMALL_EXTENT`] along each axis. Its pixel box is then within a pixel of the corners' box, so
-/// an edge value anywhere in the box or a pixel past it (where the stepping ends) is a sum of two
-/// products of factors of at most 2^12 and 2^13 — below 2^26 — plus a sample offset below 2^21:
-/// far inside `i32`.
+/// an edge value anywhere in the box or up to two pixels past it (where the two-pixel steps end)
+/// is a sum of two products of factors of at most 2^12 and 2^13 — below 2^26 — plus a sample
+/// offset below 2^21: far inside `i32`.
 #[cfg_attr(
     not(all(target_arch = "x86_64", target_feature = "avx2")),
     allow(dead_code)
