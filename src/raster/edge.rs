@@ -90,17 +90,19 @@ pub(crate) fn rasterize(
     }
     let rect = [x0, y0, x1, y1];
     let s = offsets.len();
+    let edges = edges_at(st, x0, y0);
     #[cfg(all(target_arch = "x86_64", target_feature = "avx2"))]
     if scans == Scans::Fastest && s == 4 && buf.counts.is_none() && small(st) {
-        // SAFETY: this build targets AVX2 (cfg); the triangle is small (`small`), and `rect`
-        // lies within the tile's rectangle, `buf.rect`.
-        unsafe { avx2::rasterize_small(st, id, offsets, rect, buf) };
+        // SAFETY: this build targets AVX2 (cfg); the triangle is small (`small`, which bounds
+        // every edge value the lanes reach, so the narrowed edges are exact), `rect` lies within
+        // the triangle's box and the tile's rectangle, `buf.rect`, and there are 4 offsets.
+        unsafe { avx2::scan_four(st, id, rect, &avx2::Edges32::narrow(&edges), offsets, buf) };
         return;
     }
     // Builds without AVX2 have only the scalar scans.
     #[cfg(not(all(target_arch = "x86_64", target_feature = "avx2")))]
     let _ = scans;
-    let Edges { origin, coef, bias } = edges_at(st, x0, y0);
+    let Edges { origin, coef, bias } = edges;
     if s == 1 && buf.counts.is_none() {
         // One sample per pixel (a dense mesh's triangles cover a pixel or two): the sample offset
         // and bias go straight into the start values, with no per-sample table.
@@ -361,15 +363,27 @@ fn scan<const S: usize, const COUNT: bool>(
 /// scan's operations in its order (so the same bits), and a branch-free depth test by blending.
 #[cfg(all(target_arch = "x86_64", target_feature = "avx2"))]
 mod avx2 {
-    use super::{SetupTri, TileSamples};
+    use super::{Edges, SetupTri, TileSamples};
     use std::arch::x86_64::*;
 
-    /// A small triangle's edge functions in 32 bits: value at the first pixel's corner
-    /// (unbiased), x and y coefficients, top-left bias.
-    struct Edges32 {
+    /// A small triangle's edge functions ([`Edges`]) in 32 bits: value at the first pixel's
+    /// corner (unbiased), x and y coefficients, top-left bias.
+    pub(super) struct Edges32 {
         origin: [i32; 3],
         coef: [[i32; 2]; 3],
         bias: [i32; 3],
+    }
+
+    impl Edges32 {
+        /// `edges` narrowed to `i32`: exact for a [`super::small`] triangle, whose edge values
+        /// and coefficients it bounds far inside that range.
+        pub(super) fn narrow(edges: &Edges) -> Edges32 {
+            Edges32 {
+                origin: edges.origin.map(|v| v as i32),
+                coef: edges.coef.map(|c| c.map(|v| v as i32)),
+                bias: edges.bias.map(|v| v as i32),
+            }
+        }
     }
 
     /// Per-triangle constants of the depth lanes: the corner depths and 1/area.
@@ -458,48 +472,15 @@ mod avx2 {
         v
     }
 
-    /// [`super::rasterize`] for a [`super::small`] triangle at four samples per pixel, in 32-bit
-    /// lanes: the same edge values, coverage and depths as the 64-bit scan.
-    ///
-    /// # Safety
-    /// The CPU must have AVX2; `super::small(st)` holds; `rect` is non-empty, within the
-    /// triangle's box and within `buf.rect`; `offsets` has 4 entries, as `buf.samples`.
-    #[target_feature(enable = "avx2")]
-    pub(super) unsafe fn rasterize_small(
-        st: &SetupTri,
-        id: u32,
-        offsets: &[[i64; 2]],
-        rect: [i32; 4],
-        buf: &mut TileSamples,
-    ) {
-        let one = crate::raster::fixed::ONE_PIXEL as i32;
-        let p = st.v;
-        // Edge i: from p[i+1] to p[i+2]; E = −d.y·(x − a.x) + d.x·(y − a.y) (`edges_at`), in i32:
-        // `small` bounds every value (see there).
-        let mut edges = Edges32 {
-            origin: [0; 3],
-            coef: [[0; 2]; 3],
-            bias: [0; 3],
-        };
-        for i in 0..3 {
-            let a = p[(i + 1) % 3];
-            let b = p[(i + 2) % 3];
-            let (dx, dy) = (b[0] - a[0], b[1] - a[1]);
-            edges.coef[i] = [-dy, dx];
-            edges.origin[i] = -dy * (rect[0] * one - a[0]) + dx * (rect[1] * one - a[1]);
-            edges.bias[i] = if (dy == 0 && dx > 0) || dy < 0 { 0 } else { -1 };
-        }
-        // SAFETY: as this function's contract.
-        unsafe { scan_four(st, id, rect, &edges, offsets, buf) }
-    }
-
     /// Four samples per pixel at `offsets`, two pixels of a row (eight samples, contiguous in
     /// the buffer) per step; a depth only where one of them is covered.
     ///
     /// # Safety
-    /// As [`rasterize_small`].
+    /// The CPU must have AVX2; `super::small(st)` holds and `edges` are its edges at `rect`'s
+    /// first pixel corner; `rect` is non-empty, within the triangle's box and within
+    /// `buf.rect`; `offsets` has 4 entries, as `buf.samples`.
     #[target_feature(enable = "avx2")]
-    unsafe fn scan_four(
+    pub(super) unsafe fn scan_four(
         st: &SetupTri,
         id: u32,
         [x0, y0, x1, y1]: [i32; 4],
