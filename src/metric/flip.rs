@@ -22,6 +22,7 @@
 use glam::Vec3;
 use rayon::prelude::*;
 
+use super::runs::map_runs;
 use crate::color::{rgb_to_xyz, xyz_to_lab, xyz_to_rgb, xyz_to_ycxcz, ycxcz_to_xyz};
 use crate::error::Result;
 use crate::image::{ErrorMap, LinearImage, same_dims, same_size};
@@ -301,19 +302,14 @@ impl Flip {
             &[(0, &y), (1, &cx), (2, &cz1), (3, &cz2)],
             |s, row| {
                 // Runs of equal filtered values (a flat background) convert once.
-                let mut last: Option<(Vec3, Vec3)> = None;
-                for (x, o) in row.iter_mut().enumerate() {
-                    let filtered = Vec3::new(s[x], s[w + x], s[2 * w + x] + s[3 * w + x]);
-                    *o = match last {
-                        Some((f, lab)) if f == filtered => lab,
-                        _ => {
-                            let rgb =
-                                xyz_to_rgb(ycxcz_to_xyz(filtered)).clamp(Vec3::ZERO, Vec3::ONE);
-                            let lab = hunt(xyz_to_lab(rgb_to_xyz(rgb)));
-                            last = Some((filtered, lab));
-                            lab
-                        }
-                    };
+                let filtered =
+                    (0..row.len()).map(|x| Vec3::new(s[x], s[w + x], s[2 * w + x] + s[3 * w + x]));
+                let labs = map_runs(filtered, |f| {
+                    let rgb = xyz_to_rgb(ycxcz_to_xyz(f)).clamp(Vec3::ZERO, Vec3::ONE);
+                    hunt(xyz_to_lab(rgb_to_xyz(rgb)))
+                });
+                for (o, lab) in row.iter_mut().zip(labs) {
+                    *o = lab;
                 }
             },
         );

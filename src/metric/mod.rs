@@ -2,7 +2,7 @@
 //! ([`LinearImage`]), is prepared once per reference where it has per-image work, and returns
 //! named results with units. One metric per file, in the order of the maths:
 //! `mse.rs` (MSE, PSNR, d_MS), `ssim.rs` (SSIM, MS-SSIM), `flip.rs` (ꟻLIP),
-//! `pool.rs` (pooling), `csf.rs` (contrast sensitivity), `tvi.rs` (threshold versus intensity),
+//! `pool.rs` (pooling), `runs.rs` (maps evaluated once per run of equal values), `csf.rs` (contrast sensitivity), `tvi.rs` (threshold versus intensity),
 //! `vdp/` (the visible-difference predictor, one stage per file).
 
 pub mod colormap;
@@ -11,6 +11,7 @@ pub mod flip;
 pub mod hdr_flip;
 pub mod mse;
 pub mod pool;
+pub(crate) mod runs;
 pub mod ssim;
 pub mod tvi;
 pub mod vdp;

@@ -15,6 +15,7 @@
 
 use super::bands::Plane;
 use crate::metric::csf::DalyCsf;
+use crate::metric::runs::map_runs;
 
 /// Lowest tabulated adaptation luminance, cd/m² (darker is clamped to it).
 pub const L_MIN: f64 = 1e-3;
@@ -66,7 +67,7 @@ impl BandAdaptation {
         let gains: Vec<f32> = adapt
             .v
             .par_chunks(aw)
-            .flat_map_iter(|row| super::map_runs(row, |l| self.gain(l)))
+            .flat_map_iter(|row| map_runs(row.iter().copied(), |l| self.gain(l)))
             .collect();
         band.v.par_chunks_mut(w).enumerate().for_each(|(y, row)| {
             let grow = &gains[(y / 2).min(ah - 1) * aw..][..aw];

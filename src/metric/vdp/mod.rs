@@ -59,6 +59,7 @@ use self::adaptation::BandAdaptation;
 use self::bands::Plane;
 use self::filter::CsfFilter;
 use super::csf::DalyCsf;
+use super::runs::map_runs;
 use crate::color::luminance;
 use crate::error::{Error, Result};
 use crate::image::{ErrorMap, LinearImage, same_dims, same_size};
@@ -138,24 +139,6 @@ pub struct VdpScore {
     /// Per-pixel detection probability in [0, 1] of the difference around the pixel
     /// ([`MAP_WINDOW_DEG`]); never above `probability`.
     pub map: ErrorMap,
-}
-
-/// `f` of every value of `row`, evaluated once per run of equal values (a flat background
-/// costs one call): the same values as mapping every element, for an `f` that maps 0 and −0
-/// alike (runs compare with `==`).
-pub(crate) fn map_runs<'a>(
-    row: &'a [f32],
-    f: impl Fn(f32) -> f32 + 'a,
-) -> impl Iterator<Item = f32> + 'a {
-    let mut last: Option<(f32, f32)> = None;
-    row.iter().map(move |&x| match last {
-        Some((m, y)) if m == x => y,
-        _ => {
-            let y = f(x);
-            last = Some((x, y));
-            y
-        }
-    })
 }
 
 impl Vdp {
@@ -268,7 +251,11 @@ impl Vdp {
             v: lum
                 .v
                 .par_chunks(w)
-                .flat_map_iter(|row| map_runs(row, |l| l.max(adaptation::L_MIN as f32).ln()))
+                .flat_map_iter(|row| {
+                    map_runs(row.iter().copied(), |l| {
+                        l.max(adaptation::L_MIN as f32).ln()
+                    })
+                })
                 .collect(),
         };
         let filtered = self.filter(w, h).apply(&log);
