@@ -22,7 +22,7 @@ pub const TILE: u32 = 64;
 /// How many triangles ahead [`Binned::tile`] asks for a record.
 const LOOKAHEAD: usize = 4;
 /// Source triangles per set-up chunk.
-const CHUNK: usize = 4096;
+pub(crate) const CHUNK: usize = 4096;
 
 /// The set-up triangles of one chunk, sorted by tile.
 #[derive(Debug, Clone)]
@@ -38,8 +38,6 @@ pub(crate) struct SetupChunk {
 #[derive(Debug, Clone)]
 pub(crate) struct Binned {
     chunks: Vec<SetupChunk>,
-    tiles_x: u32,
-    n_tiles: usize,
 }
 
 impl Binned {
@@ -52,22 +50,6 @@ impl Binned {
     pub fn corners(&self, id: u32) -> Corners {
         let clipped = &self.chunks[(id >> 16) as usize].clipped;
         Corners::decode(self.get(id).corners, clipped)
-    }
-
-    /// Number of tiles.
-    pub fn tile_count(&self) -> usize {
-        self.n_tiles
-    }
-
-    /// Pixel rectangle `[x0, y0, x1, y1)` of tile `t`.
-    pub fn tile_rect(&self, t: usize, width: u32, height: u32) -> [i32; 4] {
-        let (tx, ty) = (t as u32 % self.tiles_x, t as u32 / self.tiles_x);
-        [
-            (tx * TILE) as i32,
-            (ty * TILE) as i32,
-            ((tx + 1) * TILE).min(width) as i32,
-            ((ty + 1) * TILE).min(height) as i32,
-        ]
     }
 
     /// The set-up triangles touching tile `t`, as (id, triangle), in source-triangle order.
@@ -83,10 +65,67 @@ impl Binned {
                 if let Some(&ahead) = items.get(j + LOOKAHEAD) {
                     crate::prefetch::prefetch(&chunk.tris[ahead as usize]);
                 }
-                (((c as u32) << 16) | k as u32, &chunk.tris[k as usize])
+                (setup_id(c, k as usize), &chunk.tris[k as usize])
             })
         })
     }
+}
+
+/// Number of tiles of a `width` × `height` frame.
+pub fn tile_count(width: u32, height: u32) -> usize {
+    (width.div_ceil(TILE) * height.div_ceil(TILE)) as usize
+}
+
+/// Pixel rectangle `[x0, y0, x1, y1)` of tile `t` (row-major) of a `width` × `height` frame.
+pub fn tile_rect(t: usize, width: u32, height: u32) -> [i32; 4] {
+    let tiles_x = width.div_ceil(TILE);
+    let (tx, ty) = (t as u32 % tiles_x, t as u32 / tiles_x);
+    [
+        (tx * TILE) as i32,
+        (ty * TILE) as i32,
+        ((tx + 1) * TILE).min(width) as i32,
+        ((ty + 1) * TILE).min(height) as i32,
+    ]
+}
+
+/// The set-up triangles of chunks of [`CHUNK`] source triangles (chunk c's output of
+/// [`setup_one`] is `outs[c]`), unbinned: their ids are those of [`setup_and_bin`], and every
+/// tile's list is empty.
+pub(crate) fn unbinned(outs: Vec<SetupOut>, n_tiles: usize) -> Binned {
+    let chunks = outs
+        .into_iter()
+        .map(|SetupOut { tris, clipped }| SetupChunk {
+            tris,
+            clipped,
+            tile_start: vec![0; n_tiles + 1],
+            items: Vec::new(),
+        })
+        .collect();
+    Binned { chunks }
+}
+
+/// Set up chunk `c` of the source triangles (`chunk`, from triangle `c * CHUNK`), in order.
+pub(crate) fn setup_chunk(
+    c: usize,
+    chunk: &[[u32; 3]],
+    xf: &[XfVertex],
+    planes: &ClipPlanes,
+    vp: Viewport,
+) -> SetupOut {
+    let mut out = SetupOut {
+        tris: Vec::with_capacity(chunk.len()),
+        clipped: Vec::new(),
+    };
+    for (k, t) in chunk.iter().enumerate() {
+        setup_one((c * CHUNK + k) as u32, *t, xf, planes, vp, &mut out);
+    }
+    out
+}
+
+/// The id of triangle `k` of chunk `c`'s set-up output.
+#[inline]
+pub(crate) fn setup_id(c: usize, k: usize) -> u32 {
+    ((c as u32) << 16) | k as u32
 }
 
 /// Set up and bin every triangle.
@@ -97,19 +136,12 @@ pub(crate) fn setup_and_bin(
     vp: Viewport,
 ) -> Binned {
     let tiles_x = vp.width.div_ceil(TILE);
-    let n_tiles = (tiles_x * vp.height.div_ceil(TILE)) as usize;
+    let n_tiles = tile_count(vp.width, vp.height);
     let chunks = triangles
         .par_chunks(CHUNK)
         .enumerate()
         .map(|(c, chunk)| {
-            let mut out = SetupOut {
-                tris: Vec::with_capacity(chunk.len()),
-                clipped: Vec::new(),
-            };
-            for (k, t) in chunk.iter().enumerate() {
-                setup_one((c * CHUNK + k) as u32, *t, xf, planes, vp, &mut out);
-            }
-            let SetupOut { tris, clipped } = out;
+            let SetupOut { tris, clipped } = setup_chunk(c, chunk, xf, planes, vp);
             // Counting sort by tile: count, prefix-sum, scatter (keeps triangle order per tile).
             // Explicit loops: most triangles touch one tile, and nested iterator adapters here
             // cost more than the counting itself.
@@ -154,9 +186,5 @@ pub(crate) fn setup_and_bin(
             }
         })
         .collect();
-    Binned {
-        chunks,
-        tiles_x,
-        n_tiles,
-    }
+    Binned { chunks }
 }

@@ -111,17 +111,14 @@ pub(crate) fn rasterize(
         for i in 0..3 {
             start[i] += off[i];
         }
-        scan_one_sample(
-            st,
-            id,
-            rect,
-            &Edges {
-                origin: start,
-                coef,
-                bias,
-            },
-            buf,
-        );
+        let edges = Edges {
+            origin: start,
+            coef,
+            bias,
+        };
+        scan_one_sample(st, rect, buf.rect, &edges, |pixel, depth| {
+            depth_test(buf, pixel, id, depth)
+        });
         return;
     }
     // Per-sample offsets of each edge value from the pixel corner, bias folded in, written into the
@@ -260,21 +257,75 @@ fn small(st: &SetupTri) -> bool {
 }
 
 /// The pixel loop of [`rasterize`] at one sample per pixel, without coverage counting: `edges`
-/// origin holds the biased edge values at the first pixel's sample. The same tests and depths as
-/// [`scan`] with `S = 1`.
-fn scan_one_sample(st: &SetupTri, id: u32, rect: [i32; 4], edges: &Edges, buf: &mut TileSamples) {
+/// origin holds the biased edge values at the first pixel's sample. Calls `test(pixel, depth)`
+/// for every covered pixel of `rect` (`pixel` indexes the rectangle `frame` row-major) with the
+/// same tests and depths as [`scan`] with `S = 1`.
+#[inline(always)]
+fn scan_one_sample(
+    st: &SetupTri,
+    rect: [i32; 4],
+    frame: [i32; 4],
+    edges: &Edges,
+    mut test: impl FnMut(usize, f32),
+) {
     let bias = edges.bias;
     // 1/area on the first covered sample: a third of a dense mesh's triangles cover none.
     let mut inv_area = 0.0f64;
-    for_each_pixel(rect, buf.rect, edges, |pixel, e| {
+    for_each_pixel(rect, frame, edges, |pixel, e| {
         if (e[0] | e[1] | e[2]) >= 0 {
             if inv_area == 0.0 {
                 inv_area = 1.0 / st.area() as f64;
             }
             let w = [0, 1, 2].map(|i| (e[i] - bias[i]) as f64);
-            depth_test(buf, pixel, id, interpolated_depth(st, w, inv_area));
+            test(pixel, interpolated_depth(st, w, inv_area));
         }
     });
+}
+
+/// Sort-last scan (`sort_last.rs`): rasterize set-up triangle `st` (index `id`) at one sample
+/// per pixel, offset `offset` (Fx24_8), into the `width`-pixel-wide frame of depth-and-id keys
+/// `keys` (row-major), keeping the smaller [`depth_key`] per pixel. For every pixel the result
+/// is the nearest depth, ties to the smaller id: what [`rasterize`] gives when triangles arrive
+/// in id order, whatever order they arrive in here.
+pub(crate) fn rasterize_keys(
+    st: &SetupTri,
+    id: u32,
+    offset: [i64; 2],
+    [width, height]: [i32; 2],
+    keys: &mut [u64],
+) {
+    let bbox = st.bbox();
+    let x1 = bbox[2].min(width);
+    let y1 = bbox[3].min(height);
+    if bbox[0] >= x1 || bbox[1] >= y1 {
+        return;
+    }
+    let rect = [bbox[0], bbox[1], x1, y1];
+    let Edges { origin, coef, bias } = edges_at(st, rect[0], rect[1]);
+    let off = sample_offset(&coef, &bias, offset);
+    let mut start = origin;
+    for i in 0..3 {
+        start[i] += off[i];
+    }
+    let edges = Edges {
+        origin: start,
+        coef,
+        bias,
+    };
+    scan_one_sample(st, rect, [0, 0, width, height], &edges, |pixel, depth| {
+        let key = depth_key(depth, id);
+        if key < keys[pixel] {
+            keys[pixel] = key;
+        }
+    });
+}
+
+/// A sample's depth and triangle id as one number whose order is (depth, id): depths are
+/// non-negative (NDC 0..1, weights ≥ 0), and a non-negative `f32`'s bits order as its value.
+/// No key is `u64::MAX`, which marks an empty sample.
+#[inline(always)]
+pub(crate) fn depth_key(depth: f32, id: u32) -> u64 {
+    ((depth.to_bits() as u64) << 32) | id as u64
 }
 
 /// Call `f(pixel, e)` for the pixels of `rect` in row-major order, with the pixel's index in the

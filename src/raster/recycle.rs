@@ -27,6 +27,7 @@ pub(crate) struct Pool {
     color: Vec<Vec<Vec3>>,
     scalar: Vec<Vec<f32>>,
     id: Vec<Vec<u32>>,
+    key: Vec<Vec<u64>>,
 }
 
 static POOL: Mutex<Pool> = Mutex::new(Pool::new());
@@ -60,12 +61,22 @@ impl Recyclable for u32 {
     }
 }
 
+impl Recyclable for u64 {
+    // The sort-last workers' depth-and-id buffers (`sort_last.rs`): one per worker, two on the
+    // machines CI runs on.
+    const PER_FRAME: usize = 2;
+    fn list(pool: &mut Pool) -> &mut Vec<Vec<Self>> {
+        &mut pool.key
+    }
+}
+
 impl Pool {
     const fn new() -> Pool {
         Pool {
             color: Vec::new(),
             scalar: Vec::new(),
             id: Vec::new(),
+            key: Vec::new(),
         }
     }
 
@@ -101,6 +112,12 @@ fn with_pool<R>(f: impl FnOnce(&mut Pool) -> R) -> R {
 /// (old contents) if there is one of that length, otherwise `n` copies of `fill`.
 pub(crate) fn take<T: Recyclable>(n: usize, fill: T) -> Vec<T> {
     with_pool(|p| p.take(n)).unwrap_or_else(|| filled(n, fill))
+}
+
+/// A kept buffer of exactly `n` entries (old contents), if there is one. Unlike [`take`] it
+/// never starts parallel work, so a caller may hold a lock across it.
+pub(crate) fn take_kept<T: Recyclable>(n: usize) -> Option<Vec<T>> {
+    with_pool(|p| p.take(n))
 }
 
 /// Give `buffer` back for a later [`take`].

@@ -15,8 +15,22 @@ use super::frame::{Frame, NO_TRIANGLE};
 use super::recycle;
 use super::setup::{self, Viewport};
 use super::shade::{ResolvedLight, ShadeContext};
+use super::sort_last::{self, FrameKeys};
 use super::{RenderSettings, Shading, camera_setup, vertex_lighting};
 use crate::scene::Camera;
+
+/// How a pass finds what each sample sees.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Visibility {
+    /// Renders: sort-last where it applies (one sample per pixel, within its memory budget),
+    /// tiles otherwise.
+    Fastest,
+    /// Tiles only (the tests' reference for the sort-last path: the same frames).
+    #[cfg_attr(not(test), allow(dead_code))]
+    Tiled,
+    /// Tiles, counting every triangle that covers a sample instead of depth testing.
+    Counts,
+}
 
 /// Set-up state of one frame.
 #[derive(Debug)]
@@ -24,6 +38,9 @@ pub(crate) struct Pass {
     pub scene: RenderScene,
     pub settings: RenderSettings,
     pub binned: Binned,
+    /// The frame's visibility where it was found sort-last (`sort_last.rs`); `None`: each tile
+    /// is scanned from its list in `binned`.
+    keys: Option<FrameKeys>,
     pub offsets: Vec<[i64; 2]>,
     count_coverage: bool,
     /// Lights resolved for the camera.
@@ -181,8 +198,9 @@ impl Pass {
         scene: &RenderScene,
         camera: &Camera,
         settings: &RenderSettings,
-        count_coverage: bool,
+        visibility: Visibility,
     ) -> Pass {
+        let count_coverage = visibility == Visibility::Counts;
         let mesh = scene.mesh();
         let (mvp, depth_range) = camera_setup(camera, settings.width, settings.height);
         let offsets = settings.samples.offsets();
@@ -203,17 +221,38 @@ impl Pass {
         let planes = ClipPlanes::for_viewport(settings.width, settings.height);
         // Stage 1: transform, classify and project vertices.
         let xf = setup::transform(mesh.positions(), mvp, &planes, vp);
-        // Stage 2: set up triangles and bin them into tiles (fused, per chunk).
-        let binned = bin::setup_and_bin(mesh.triangles(), &xf, &planes, vp);
+        // Stage 2: set up triangles and bin them into tiles (fused, per chunk); or, for a
+        // one-sample frame that fits the budget, set up and scan them there and then, sort-last.
+        let sort_last = offsets.len() == 1
+            && visibility == Visibility::Fastest
+            && sort_last::fits(
+                settings.width,
+                settings.height,
+                rayon::current_num_threads(),
+            );
+        let (binned, keys) = if sort_last {
+            let (binned, keys) =
+                sort_last::setup_and_scan(mesh.triangles(), &xf, &planes, vp, offsets[0]);
+            (binned, Some(keys))
+        } else {
+            (bin::setup_and_bin(mesh.triangles(), &xf, &planes, vp), None)
+        };
         Pass {
             scene: scene.clone(),
             settings: *settings,
             binned,
+            keys,
             offsets,
             count_coverage,
             lights: ResolvedLight::for_camera(&scene.lights, camera),
             depth_range,
         }
+    }
+
+    /// Whether this pass found its visibility sort-last.
+    #[cfg(test)]
+    pub fn is_sort_last(&self) -> bool {
+        self.keys.is_some()
     }
 
     /// The shading context; for Gouraud, `vertex_light` is used if given, computed otherwise.
@@ -237,11 +276,13 @@ impl Pass {
         ctx
     }
 
-    /// Stage 3: scan-convert every triangle of tile `t` (in source-triangle order).
+    /// Stage 3: scan-convert every triangle of tile `t` (in source-triangle order), or take the
+    /// tile's share of the sort-last visibility.
     fn raster_tile(&self, t: usize) -> TileSamples {
-        let rect = self
-            .binned
-            .tile_rect(t, self.settings.width, self.settings.height);
+        let rect = bin::tile_rect(t, self.settings.width, self.settings.height);
+        if let Some(keys) = &self.keys {
+            return keys.tile(rect);
+        }
         let mut buf = TileSamples::new(rect, self.offsets.len(), self.count_coverage);
         let mut scratch = vec![[0i64; 3]; self.offsets.len()];
         for (id, tri) in self.binned.tile(t) {
@@ -353,7 +394,10 @@ impl Pass {
             triangle: recycle::take(n, 0),
         };
         let targets = frame_tiles(&mut frame, bin::TILE as usize);
-        debug_assert_eq!(targets.len(), self.binned.tile_count());
+        debug_assert_eq!(
+            targets.len(),
+            bin::tile_count(self.settings.width, self.settings.height)
+        );
         targets
             .into_par_iter()
             .enumerate()
@@ -363,10 +407,11 @@ impl Pass {
 
     /// Per-sample coverage counts over the whole image, row-major per pixel.
     pub fn counts(&self) -> Vec<u16> {
-        let tiles: Vec<TileSamples> = (0..self.binned.tile_count())
-            .into_par_iter()
-            .map(|t| self.raster_tile(t))
-            .collect();
+        let tiles: Vec<TileSamples> =
+            (0..bin::tile_count(self.settings.width, self.settings.height))
+                .into_par_iter()
+                .map(|t| self.raster_tile(t))
+                .collect();
         let (w, h) = (self.settings.width as usize, self.settings.height as usize);
         let s = self.offsets.len();
         let mut out = vec![0u16; w * h * s];

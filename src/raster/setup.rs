@@ -160,7 +160,9 @@ fn project(p: Vec4, vp: Viewport) -> Option<Projected> {
             Fx24_8::from_px((nx * 0.5 + 0.5) * vp.width as f32).0,
             Fx24_8::from_px((0.5 - ny * 0.5) * vp.height as f32).0,
         ],
-        z: (p.z * iw).clamp(0.0, 1.0),
+        // `+ 0.0` turns a -0.0 into +0.0: depths are then never negative zero, whose bits would
+        // order after every positive depth in `edge::depth_key`.
+        z: (p.z * iw).clamp(0.0, 1.0) + 0.0,
         inv_w: iw,
     })
 }

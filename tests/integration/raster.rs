@@ -41,9 +41,16 @@ fn frames_are_byte_identical_for_1_2_and_8_threads_with_every_shading_model() {
     for rel in ["spot/spot_mtl.obj", "barrel/barrel.glb"] {
         let scene = RenderScene::of(load(rel));
         let camera = Rig::Dodecahedron.cameras(scene.mesh(), 1.5)[5];
-        for shading in Shading::ALL {
+        // Four samples per pixel (tiles) and one (sort-last: every worker its own buffer).
+        for (shading, samples) in Shading::ALL.into_iter().flat_map(|m| {
+            [
+                (m, SamplePattern::Rotated(2)),
+                (m, SamplePattern::Ordered(1)),
+            ]
+        }) {
             let mut s = settings(96, shading);
             s.width = 144;
+            s.samples = samples;
             let reference =
                 bits(&with_threads(1, || raster::render(&scene, &camera, &s).unwrap()).unwrap());
             for threads in [2, 8, 8] {
@@ -51,7 +58,7 @@ fn frames_are_byte_identical_for_1_2_and_8_threads_with_every_shading_model() {
                     with_threads(threads, || raster::render(&scene, &camera, &s).unwrap()).unwrap();
                 assert!(
                     bits(&f) == reference,
-                    "{rel} {}: {threads} threads differ from 1",
+                    "{rel} {} {samples:?}: {threads} threads differ from 1",
                     shading.name()
                 );
             }
