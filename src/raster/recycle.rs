@@ -7,9 +7,13 @@
 //! results/BENCHMARKS.md). Rendering many views in a loop — what `eval` and `bench` do — frees one
 //! frame and allocates the next of the same size, so a few kept buffers remove the faults.
 //!
+//! The sort-last path's per-worker key buffers (`sort_last.rs`, 8 MB each at 1024²) are kept
+//! the same way.
+//!
 //! A recycled buffer keeps its old values: only callers that overwrite every entry may take one
-//! (`resolve_frame` does: every pixel belongs to exactly one tile, which writes it). Outputs
-//! therefore never depend on what the pool holds. The pool is bounded ([`KEEP_FRAMES`] frames'
+//! (`resolve_frame` does: every pixel belongs to exactly one tile, which writes it; the sort-last
+//! scan fills a kept key buffer before using it). Outputs therefore never depend on what the
+//! pool holds. The pool is bounded ([`KEEP_FRAMES`] frames'
 //! worth of buffers, each at least [`MIN_LEN`] entries).
 
 use std::sync::Mutex;
@@ -179,7 +183,7 @@ mod tests {
     #[test]
     fn a_render_on_recycled_garbage_equals_one_on_fresh_buffers() {
         use crate::raster::RenderScene;
-        use crate::raster::{RenderSettings, Shading, render};
+        use crate::raster::{RenderSettings, SamplePattern, Shading, render};
         use crate::scene::Rig;
         use std::sync::Arc;
         // A size no other test renders at, so no other thread takes or gives these buffers.
@@ -187,24 +191,34 @@ mod tests {
         let n = (w * h) as usize;
         let scene = RenderScene::of(Arc::new(crate::mesh::shapes::icosphere(3)));
         let camera = Rig::Dodecahedron.cameras(scene.mesh(), 1.0)[4];
-        let mut settings = RenderSettings::DEFAULT;
-        (settings.width, settings.height, settings.shading) = (w, h, Shading::Phong);
         let drain = || {
             while with_pool(|p| {
                 let found = p.take::<Vec3>(n).is_some() | p.take::<f32>(n).is_some();
-                found | p.take::<u32>(n).is_some()
+                found | p.take::<u32>(n).is_some() | p.take::<u64>(n).is_some()
             }) {}
         };
-        drain();
-        let fresh = render(&scene, &camera, &settings).unwrap();
-        drain();
-        for _ in 0..2 {
-            give(vec![Vec3::splat(f32::NAN); n]);
-            give(vec![f32::NAN; n]);
-            give(vec![f32::NAN; n]);
-            give(vec![0xDEAD_BEEFu32; n]);
+        // Four samples per pixel (tiles) and one (sort-last, which also takes key buffers).
+        for samples in [SamplePattern::Rotated(2), SamplePattern::Ordered(1)] {
+            let mut settings = RenderSettings::DEFAULT;
+            (settings.width, settings.height, settings.shading) = (w, h, Shading::Phong);
+            settings.samples = samples;
+            drain();
+            let fresh = render(&scene, &camera, &settings).unwrap();
+            drain();
+            for _ in 0..2 {
+                give(vec![Vec3::splat(f32::NAN); n]);
+                give(vec![f32::NAN; n]);
+                give(vec![f32::NAN; n]);
+                give(vec![0xDEAD_BEEFu32; n]);
+                // Keys that would beat every triangle if they were not cleared.
+                give(vec![0u64; n]);
+            }
+            assert_eq!(
+                render(&scene, &camera, &settings).unwrap(),
+                fresh,
+                "{samples:?}"
+            );
         }
-        assert_eq!(render(&scene, &camera, &settings).unwrap(), fresh);
     }
 
     #[test]
