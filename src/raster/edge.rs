@@ -102,25 +102,16 @@ pub(crate) fn rasterize(
     // Builds without AVX2 have only the scalar scans.
     #[cfg(not(all(target_arch = "x86_64", target_feature = "avx2")))]
     let _ = scans;
-    let Edges { origin, coef, bias } = edges;
     if s == 1 && buf.counts.is_none() {
         // One sample per pixel (a dense mesh's triangles cover a pixel or two): the sample offset
         // and bias go straight into the start values, with no per-sample table.
-        let off = sample_offset(&coef, &bias, offsets[0]);
-        let mut start = origin;
-        for i in 0..3 {
-            start[i] += off[i];
-        }
-        let edges = Edges {
-            origin: start,
-            coef,
-            bias,
-        };
+        let edges = edges.at_sample(offsets[0]);
         scan_one_sample(st, rect, buf.rect, &edges, |pixel, depth| {
             depth_test(buf, pixel, id, depth)
         });
         return;
     }
+    let Edges { origin, coef, bias } = edges;
     // Per-sample offsets of each edge value from the pixel corner, bias folded in, written into the
     // caller's scratch (a zero-initialised array per triangle cost more than the rasterization).
     let sample_off = &mut scratch[..s];
@@ -238,6 +229,19 @@ struct Edges {
     bias: [i64; 3],
 }
 
+impl Edges {
+    /// These edge functions with the sample at `o` (Fx24_8, within the pixel) and the top-left
+    /// bias folded into the origin: the one-sample scans' start values.
+    #[inline(always)]
+    fn at_sample(mut self, o: [i64; 2]) -> Edges {
+        let off = sample_offset(&self.coef, &self.bias, o);
+        for i in 0..3 {
+            self.origin[i] += off[i];
+        }
+        self
+    }
+}
+
 /// Largest extent of a [`small`] triangle's corners along x and along y, Fx24_8 (16 pixels).
 const SMALL_EXTENT: i32 = 16 << super::fixed::SUBPIXEL_BITS;
 
@@ -301,17 +305,7 @@ pub(crate) fn rasterize_keys(
         return;
     }
     let rect = [bbox[0], bbox[1], x1, y1];
-    let Edges { origin, coef, bias } = edges_at(st, rect[0], rect[1]);
-    let off = sample_offset(&coef, &bias, offset);
-    let mut start = origin;
-    for i in 0..3 {
-        start[i] += off[i];
-    }
-    let edges = Edges {
-        origin: start,
-        coef,
-        bias,
-    };
+    let edges = edges_at(st, rect[0], rect[1]).at_sample(offset);
     scan_one_sample(st, rect, [0, 0, width, height], &edges, |pixel, depth| {
         let key = depth_key(depth, id);
         if key < keys[pixel] {
