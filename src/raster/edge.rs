@@ -235,8 +235,8 @@ impl Edges {
     #[inline(always)]
     fn at_sample(mut self, o: [i64; 2]) -> Edges {
         let off = sample_offset(&self.coef, &self.bias, o);
-        for i in 0..3 {
-            self.origin[i] += off[i];
+        for (e, d) in self.origin.iter_mut().zip(off) {
+            *e += d;
         }
         self
     }
