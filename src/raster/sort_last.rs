@@ -11,7 +11,7 @@
 //! (Molnar, Cox, Ellsworth, Fuchs. A Sorting Classification of Parallel Rendering. IEEE CG&A
 //! 1994: "sort-last" composites full-frame partial images by depth.)
 //!
-//! Determinism: a pixel keeps the smallest [`depth_key`] — its nearest depth, ties to the smaller
+//! Determinism: a pixel keeps the smallest [`edge::depth_key`] — its nearest depth, ties to the smaller
 //! set-up id — which is a minimum over all the triangles covering it, so it does not depend on
 //! which worker scanned which chunk or in what order, nor on how many buffers there were. It is
 //! also exactly what the tiled path keeps (triangles in id order, strict depth test), so both
