@@ -2,8 +2,9 @@
 //! ([`LinearImage`]), is prepared once per reference where it has per-image work, and returns
 //! named results with units. One metric per file, in the order of the maths:
 //! `mse.rs` (MSE, PSNR, d_MS), `ssim.rs` (SSIM, MS-SSIM), `flip.rs` (ꟻLIP),
-//! `pool.rs` (pooling), `runs.rs` (maps evaluated once per run of equal values), `csf.rs` (contrast sensitivity), `tvi.rs` (threshold versus intensity),
-//! `vdp/` (the visible-difference predictor, one stage per file).
+//! `pool.rs` (pooling), `runs.rs` (maps evaluated once per run of equal values), `csf.rs`
+//! (contrast sensitivity), `tvi.rs` (threshold versus intensity), `vdp/` (the visible-difference
+//! predictor, one stage per file).
 
 pub mod colormap;
 pub mod csf;

@@ -13,8 +13,8 @@
 //! A recycled buffer keeps its old values: only callers that overwrite every entry may take one
 //! (`resolve_frame` does: every pixel belongs to exactly one tile, which writes it; the sort-last
 //! scan fills a kept key buffer before using it). Outputs therefore never depend on what the
-//! pool holds. The pool is bounded ([`KEEP_FRAMES`] frames'
-//! worth of buffers, each at least [`MIN_LEN`] entries).
+//! pool holds. The pool is bounded ([`KEEP_FRAMES`] frames' worth of buffers, each at least
+//! [`MIN_LEN`] entries).
 
 use std::sync::Mutex;
 
@@ -115,7 +115,7 @@ fn with_pool<R>(f: impl FnOnce(&mut Pool) -> R) -> R {
 /// A buffer of exactly `n` entries whose contents the caller will overwrite entirely: a kept one
 /// (old contents) if there is one of that length, otherwise `n` copies of `fill`.
 pub(crate) fn take<T: Recyclable>(n: usize, fill: T) -> Vec<T> {
-    with_pool(|p| p.take(n)).unwrap_or_else(|| filled(n, fill))
+    take_kept(n).unwrap_or_else(|| filled(n, fill))
 }
 
 /// A kept buffer of exactly `n` entries (old contents), if there is one. Unlike [`take`] it

@@ -223,14 +223,14 @@ impl Pass {
         let xf = setup::transform(mesh.positions(), mvp, &planes, vp);
         // Stage 2: set up triangles and bin them into tiles (fused, per chunk); or, for a
         // one-sample frame that fits the budget, set up and scan them there and then, sort-last.
-        let sort_last = offsets.len() == 1
+        let found_sort_last = offsets.len() == 1
             && visibility == Visibility::Fastest
             && sort_last::fits(
                 settings.width,
                 settings.height,
                 rayon::current_num_threads(),
             );
-        let (binned, keys) = if sort_last {
+        let (binned, keys) = if found_sort_last {
             let (binned, keys) =
                 sort_last::setup_and_scan(mesh.triangles(), &xf, &planes, vp, offsets[0]);
             (binned, Some(keys))
