@@ -56,8 +56,8 @@ pub fn optimize(
         progress.set_position(n)
     });
     progress.finish();
-    let outcome = outcome?;
-    crate::mesh::write_obj::write(&outcome.mesh, &job.out)?;
+    let mut outcome = outcome?;
+    outcome.warnings = crate::mesh::write_obj::write(&outcome.mesh, &job.out)?;
     if let Some(path) = &job.energy_csv {
         crate::io::csv::write_rows(path, None, &outcome.log)?;
     }

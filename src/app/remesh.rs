@@ -27,6 +27,8 @@ pub struct RemeshJob {
 pub struct RemeshReport {
     /// The mesh written.
     pub file: PathBuf,
+    /// What the output could not keep of the input.
+    pub warnings: Vec<String>,
     /// The method's name.
     pub method: &'static str,
     /// 3D points of the result (seam vertices once).
@@ -78,7 +80,7 @@ pub fn remesh(job: &RemeshJob) -> Result<RemeshReport> {
         ..job.options
     };
     let r = qu_meyer::remesh(&input, &options)?;
-    mesh::write_obj::write(&r.mesh, &job.out)?;
+    let warnings = mesh::write_obj::write(&r.mesh, &job.out)?;
     if let (Some(dir), Some(images)) = (&job.maps, &r.maps) {
         images.write(dir)?;
     }
@@ -96,5 +98,6 @@ pub fn remesh(job: &RemeshJob) -> Result<RemeshReport> {
         masked_share: r.masked_share,
         seconds: r.seconds,
         maps: map_files,
+        warnings,
     })
 }

@@ -182,7 +182,11 @@ pub fn simplify(
     let mut rows = Vec::new();
     for ((lod, error, mg), file) in lods.iter().zip(files) {
         if !gltf {
-            crate::mesh::write_obj::write(lod, &file)?;
+            for w in crate::mesh::write_obj::write(lod, &file)? {
+                if !warnings.contains(&w) {
+                    warnings.push(w);
+                }
+            }
         }
         rows.push(SimplifyRow {
             file,
@@ -261,7 +265,7 @@ pub struct WilliamsJob {
 }
 
 /// Simplify with Williams et al. 2003 and write the LOD as OBJ.
-pub fn simplify_williams(job: &WilliamsJob) -> Result<Vec<SimplifyRow>> {
+pub fn simplify_williams(job: &WilliamsJob) -> Result<SimplifyReport> {
     use crate::simplify::williams::{Options, Williams};
     let mesh = load_for_lod(&job.mesh, &job.out)?;
     let start = std::time::Instant::now();
@@ -298,13 +302,16 @@ pub fn simplify_williams(job: &WilliamsJob) -> Result<Vec<SimplifyRow>> {
     };
     let lod = w.static_lod(&cameras, job.goal, &opts)?;
     let seconds = start.elapsed().as_secs_f64();
-    crate::mesh::write_obj::write(&lod, &job.out)?;
-    Ok(vec![SimplifyRow {
-        file: job.out.clone(),
-        triangles: lod.triangle_count(),
-        ratio: lod.triangle_count() as f64 / mesh.triangle_count() as f64,
-        simplifier_error: None,
-        seconds,
-        menzel_guthe: None,
-    }])
+    let warnings = crate::mesh::write_obj::write(&lod, &job.out)?;
+    Ok(SimplifyReport {
+        rows: vec![SimplifyRow {
+            file: job.out.clone(),
+            triangles: lod.triangle_count(),
+            ratio: lod.triangle_count() as f64 / mesh.triangle_count() as f64,
+            simplifier_error: None,
+            seconds,
+            menzel_guthe: None,
+        }],
+        warnings,
+    })
 }

@@ -119,5 +119,6 @@ pub(crate) fn run(a: OptimizeArgs, quiet: bool) -> Result<(), Error> {
         o.accepted.swap,
         o.accepted.teleport
     ))?;
+    super::print::warnings(&o.warnings);
     Ok(())
 }

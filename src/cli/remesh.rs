@@ -110,6 +110,7 @@ pub(crate) fn run(a: RemeshArgs, quiet: bool) -> Result<(), Error> {
         options,
         maps: a.maps,
     })?;
+    super::print::warnings(&report.warnings);
     if a.json {
         return emit_json(&report);
     }

@@ -166,11 +166,12 @@ pub(crate) fn run(a: SimplifyArgs, quiet: bool) -> Result<(), Error> {
         return Ok(());
     }
     if a.method == MethodArg::Williams {
-        let rows = lodeval::app::simplify_williams(&williams_job(&a)?)?;
+        let report = lodeval::app::simplify_williams(&williams_job(&a)?)?;
+        super::print::warnings(&report.warnings);
         if a.json {
-            return emit_json(&rows);
+            return emit_json(&report.rows);
         }
-        for r in &rows {
+        for r in &report.rows {
             emit(&format!(
                 "{}  {} triangles ({:.4} of the input)\n",
                 r.file.display(),

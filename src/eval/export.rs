@@ -82,8 +82,10 @@ pub fn write_chain(
     let (coverage, warnings) = coverage(rows, asset, &names);
     let mut levels: Vec<(&str, &Mesh)> = vec![(asset, original)];
     levels.extend(order.iter().map(|&i| lods[i]));
-    let files = crate::mesh::write_gltf::write_lod_chain(&levels, &coverage, path)?;
-    Ok((files, warnings))
+    let mut written = crate::mesh::write_gltf::write_lod_chain(&levels, &coverage, path)?;
+    let mut all = warnings;
+    all.append(&mut written.warnings);
+    Ok((written.files, all))
 }
 
 /// The imperceptibility distances of `lods` against `original` with `eval`'s defaults (the

@@ -147,11 +147,12 @@ pub fn run(config: &Path, log: &mut dyn FnMut(&str)) -> Result<Vec<ResultRow>> {
                 let result = Arc::new(o.mesh.clone());
                 let after = d_ms(&result, &held_cams, exp.size, held_targets.clone())?;
                 let stem = format!("{}-{}-{}", spec.name, method.name(), v);
-                crate::mesh::write_obj::write(
+                // The experiment's scans carry no materials an OBJ cannot keep.
+                let _ = crate::mesh::write_obj::write(
                     &input,
                     &out.join("meshes").join(format!("{stem}-input.obj")),
                 )?;
-                crate::mesh::write_obj::write(
+                let _ = crate::mesh::write_obj::write(
                     &result,
                     &out.join("meshes").join(format!("{stem}-optimized.obj")),
                 )?;

@@ -28,7 +28,7 @@ use crate::eval::distance::{DistanceJob, search, visibility_at};
 use crate::eval::tables::DistanceBound;
 use crate::io::plot::{Series, line_plot};
 use crate::io::plot_png::Chart;
-use crate::mesh::{self, ColorSpace, LoadOptions, Material, Mesh, Texture};
+use crate::mesh::{self, ColorSpace, LoadOptions, Material, Mesh, Texture, TextureSlot};
 use crate::raster::{self, RenderScene, RenderSettings, SamplePattern};
 use crate::scene::{Camera, Rig};
 use crate::simplify::menzel_guthe::{self, Goal, Options};
@@ -451,7 +451,7 @@ fn figure1(
             "noise",
             Material {
                 base_color: Vec3::ONE,
-                base_color_texture: Some(Arc::new(noise_texture()?)),
+                base_color_texture: Some(TextureSlot::plain(Arc::new(noise_texture()?))),
                 ..own
             },
         ),

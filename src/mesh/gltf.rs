@@ -4,22 +4,18 @@
 //! no scenes, every mesh once) is loaded with its node's world transform applied; positions by the
 //! matrix, normals by its inverse transpose, and triangle winding flipped under mirroring
 //! transforms. Triangle strips and fans are converted; point and line primitives are skipped with
-//! a warning. Only the images a material actually uses are decoded (base colour and normal map),
-//! each once.
-//!
-//! Decisions: the metallic–roughness material is reduced to Blinn–Phong for lodeval's shading
-//! models by [`Material::specular_from_metallic_roughness`], with the mean of the
-//! metallic-roughness texture standing in for the texture (one specular colour per material).
-//! Only `TEXCOORD_0` is read; a material that samples another set gets a warning.
+//! a warning. Materials are loaded whole by `gltf_material.rs` (every slot, sampler and
+//! transform; each image decoded once per colour space). `TEXCOORD_0` and `TEXCOORD_1`, `COLOR_0`
+//! (RGB; an alpha below 1 is a warning) and `KHR_lights_punctual` lights (at their nodes' world
+//! transforms) are read.
 
-use std::collections::BTreeMap;
 use std::path::Path;
-use std::sync::Arc;
 
 use glam::{Mat3, Mat4, Vec2, Vec3};
 
-use super::texture::{ColorSpace, Texture};
-use super::{Format, LoadOptions, Material, MeshData, MissingAssets, Source, read_file};
+use super::{
+    FileLight, Format, LightKind, LoadOptions, Material, MeshData, Source, SourceNode, read_file,
+};
 use crate::error::{Error, Location, Result};
 
 pub(super) const REEXPORT: &str =
@@ -31,76 +27,17 @@ struct Builder {
     positions: Vec<Vec3>,
     normals: Vec<Option<Vec3>>,
     uvs: Vec<Option<Vec2>>,
+    uvs1: Vec<Option<Vec2>>,
     colors: Vec<Option<Vec3>>,
+    /// A vertex colour alpha below 1 was met (glTF COLOR_0 as VEC4).
+    color_alpha: bool,
+    lights: Vec<FileLight>,
+    nodes: Vec<SourceNode>,
     triangles: Vec<[u32; 3]>,
     material_ids: Vec<u32>,
     file_vertices: usize,
     any_without_normals: bool,
     warnings: Vec<String>,
-}
-
-fn rgba8_from(data: gltf::image::Data) -> std::result::Result<(u32, u32, Vec<u8>), String> {
-    use gltf::image::Format as F;
-    let px = &data.pixels;
-    let rgba: Vec<u8> = match data.format {
-        F::R8 => px.iter().flat_map(|&r| [r, r, r, 255]).collect(),
-        F::R8G8 => px
-            .chunks_exact(2)
-            .flat_map(|c| [c[0], c[1], 0, 255])
-            .collect(),
-        F::R8G8B8 => px
-            .chunks_exact(3)
-            .flat_map(|c| [c[0], c[1], c[2], 255])
-            .collect(),
-        F::R8G8B8A8 => px.clone(),
-        // 16-bit channels: keep the high byte (native little-endian order as `image` produces).
-        F::R16 => px
-            .chunks_exact(2)
-            .flat_map(|c| [c[1], c[1], c[1], 255])
-            .collect(),
-        F::R16G16 => px
-            .chunks_exact(4)
-            .flat_map(|c| [c[1], c[3], 0, 255])
-            .collect(),
-        F::R16G16B16 => px
-            .chunks_exact(6)
-            .flat_map(|c| [c[1], c[3], c[5], 255])
-            .collect(),
-        F::R16G16B16A16 => px
-            .chunks_exact(8)
-            .flat_map(|c| [c[1], c[3], c[5], c[7]])
-            .collect(),
-        other => return Err(format!("unsupported texel format {other:?}")),
-    };
-    Ok((data.width, data.height, rgba))
-}
-
-/// Mean of the R, G and B channels of RGBA8 texels, in 0..1.
-fn mean_channels(rgba: &[u8]) -> [f32; 3] {
-    let mut sum = [0u64; 3];
-    for px in rgba.chunks_exact(4) {
-        for c in 0..3 {
-            sum[c] += px[c] as u64;
-        }
-    }
-    let n = (rgba.len() / 4).max(1) as f64 * 255.0;
-    sum.map(|s| (s as f64 / n) as f32)
-}
-
-/// An external image must be a regular file within [`crate::limits::IMAGE_BYTES`] before the
-/// `gltf` crate reads it (a FIFO or `/dev/zero` would block or read without end).
-fn check_image_uri(base: &Path, source: gltf::image::Source) -> std::result::Result<(), String> {
-    match source {
-        gltf::image::Source::Uri { uri, .. } if !uri.starts_with("data:") && !uri.contains('%') => {
-            crate::io::check_input(&base.join(uri), "image", crate::limits::IMAGE_BYTES, "")
-                .map(|_| ())
-                .map_err(|e| match e {
-                    Error::Input { problem, .. } => problem,
-                    other => other.to_string(),
-                })
-        }
-        _ => Ok(()),
-    }
 }
 
 /// Load a glTF or GLB file.
@@ -170,112 +107,13 @@ pub(crate) fn load(path: &Path, options: &LoadOptions) -> Result<MeshData> {
         )
     })?;
 
-    // Materials, decoding each used image once per colour space.
-    let mut images: BTreeMap<(usize, bool), Arc<Texture>> = BTreeMap::new();
-    let mut warnings = Vec::new();
+    // Materials, every slot, decoding each used image once per colour space.
+    let mut images = super::gltf_material::Images::new(path, base, &buffers, options);
     let mut materials = Vec::new();
     for (mi, m) in document.materials().enumerate() {
-        let name = m
-            .name()
-            .map(str::to_string)
-            .unwrap_or_else(|| format!("material {mi}"));
-        let pbr = m.pbr_metallic_roughness();
-        let [r, g, b, _] = pbr.base_color_factor();
-        let base_color = Vec3::new(r, g, b);
-        // The metallic-roughness texture (G = roughness, B = metallic) scales the factors; lodeval's
-        // Blinn–Phong material has one specular colour and exponent, so the texture's mean is used.
-        let (mut metallic, mut roughness) = (pbr.metallic_factor(), pbr.roughness_factor());
-        if let Some(info) = pbr.metallic_roughness_texture() {
-            let source = info.texture().source().source();
-            let mean = check_image_uri(base, source.clone())
-                .ok()
-                .and_then(|()| gltf::image::Data::from_source(source, Some(base), &buffers).ok())
-                .and_then(|d| rgba8_from(d).ok())
-                .map(|(_, _, px)| mean_channels(&px));
-            match mean {
-                Some([_, g, b]) => {
-                    roughness *= g;
-                    metallic *= b;
-                }
-                None => warnings.push(format!(
-                    "material '{name}': metallic-roughness texture unreadable; using the factors"
-                )),
-            }
-        }
-        let (specular, shininess) =
-            Material::specular_from_metallic_roughness(base_color, metallic, roughness);
-        let mut mat = Material {
-            name: name.clone(),
-            base_color,
-            base_color_texture: None,
-            normal_texture: None,
-            specular,
-            shininess,
-        };
-        let wanted = [
-            pbr.base_color_texture()
-                .map(|t| (t.texture(), t.tex_coord(), ColorSpace::Srgb)),
-            m.normal_texture()
-                .map(|t| (t.texture(), t.tex_coord(), ColorSpace::Linear)),
-        ];
-        for (slot, want) in wanted.into_iter().enumerate() {
-            let Some((tex, set, space)) = want else {
-                continue;
-            };
-            if set != 0 {
-                warnings.push(format!(
-                    "material '{name}' samples TEXCOORD_{set}; lodeval reads TEXCOORD_0 only"
-                ));
-            }
-            let image = tex.source();
-            let key = (image.index(), space == ColorSpace::Srgb);
-            let decoded = match images.get(&key) {
-                Some(t) => Ok(t.clone()),
-                None => {
-                    let label = match image.source() {
-                        gltf::image::Source::Uri { uri, .. } if !uri.starts_with("data:") => {
-                            base.join(uri).display().to_string()
-                        }
-                        _ => format!("{} image {}", path.display(), image.index()),
-                    };
-                    check_image_uri(base, image.source())
-                        .and_then(|()| {
-                            gltf::image::Data::from_source(image.source(), Some(base), &buffers)
-                                .map_err(|e| e.to_string())
-                        })
-                        .and_then(rgba8_from)
-                        .and_then(|(w, h, px)| {
-                            Texture::new(label.clone(), w, h, px, space)
-                                .ok_or_else(|| format!("the image has zero size ({w}x{h})"))
-                        })
-                        .map(Arc::new)
-                        .map_err(|e| format!("image {} ('{label}'): {e}", image.index()))
-                }
-            };
-            match decoded {
-                Ok(t) => {
-                    images.insert(key, t.clone());
-                    if slot == 0 {
-                        mat.base_color_texture = Some(t);
-                    } else {
-                        mat.normal_texture = Some(t);
-                    }
-                }
-                Err(e) => match options.missing_assets {
-                    MissingAssets::Error => {
-                        return Err(Error::input_at(
-                            path,
-                            Location::Element(format!("material '{name}'")),
-                            format!("texture cannot be loaded: {e}"),
-                            "put the image next to the file, or pass --missing-assets warn to render with the base colour",
-                        ));
-                    }
-                    MissingAssets::Warn => warnings.push(format!("material '{name}': {e}")),
-                },
-            }
-        }
-        materials.push(mat);
+        materials.push(super::gltf_material::load(&m, mi, &mut images)?);
     }
+    let mut warnings = std::mem::take(&mut images.warnings);
     let default_id = materials.len() as u32;
 
     // Geometry: walk the scene graph, accumulating world transforms.
@@ -298,6 +136,15 @@ pub(crate) fn load(path: &Path, options: &LoadOptions) -> Result<MeshData> {
         let world = parent * Mat4::from_cols_array_2d(&node.transform().matrix());
         if let Some(mesh) = node.mesh() {
             add_mesh(path, &mut b, &mesh, world, &buffers, default_id)?;
+            b.nodes.push(SourceNode {
+                name: node
+                    .name()
+                    .map_or_else(|| format!("node {}", node.index()), str::to_string),
+                world,
+            });
+        }
+        if let Some(light) = node.light() {
+            b.lights.push(file_light(&light, world));
         }
         // Children pushed in reverse so they are visited in file order (deterministic numbering).
         let children: Vec<_> = node.children().collect();
@@ -309,13 +156,23 @@ pub(crate) fn load(path: &Path, options: &LoadOptions) -> Result<MeshData> {
         materials.push(Material::default_material());
     }
     warnings.append(&mut b.warnings);
+    if b.color_alpha {
+        warnings.push(
+            "COLOR_0 has alpha below 1; lodeval keeps vertex colours as RGB (the alpha is not \
+             rendered or exported)"
+                .into(),
+        );
+    }
     let has_uv = b.uvs.iter().any(Option::is_some);
+    let has_uv1 = b.uvs1.iter().any(Option::is_some);
     let has_c = b.colors.iter().any(Option::is_some);
     let file_faces = b.triangles.len();
     Ok(MeshData {
         normals: (!b.any_without_normals)
             .then(|| b.normals.iter().map(|n| n.unwrap_or(Vec3::ZERO)).collect()),
         uvs: has_uv.then(|| b.uvs.iter().map(|u| u.unwrap_or(Vec2::ZERO)).collect()),
+        uvs1: has_uv1.then(|| b.uvs1.iter().map(|u| u.unwrap_or(Vec2::ZERO)).collect()),
+        lights: b.lights,
         colors: has_c.then(|| b.colors.iter().map(|c| c.unwrap_or(Vec3::ONE)).collect()),
         positions: b.positions,
         triangles: b.triangles,
@@ -329,6 +186,7 @@ pub(crate) fn load(path: &Path, options: &LoadOptions) -> Result<MeshData> {
             file_unreferenced: 0,
             edited: false,
             files,
+            nodes: b.nodes,
         },
         warnings,
     })
@@ -389,6 +247,31 @@ fn check_primitive_accessors(path: &Path, root: &gltf::json::Root) -> Result<()>
         }
     }
     Ok(())
+}
+
+/// A `KHR_lights_punctual` light at its node's world transform: position from the translation,
+/// direction the node's −Z axis (the extension's convention).
+fn file_light(light: &gltf::khr_lights_punctual::Light, world: Mat4) -> FileLight {
+    use gltf::khr_lights_punctual::Kind;
+    FileLight {
+        name: light.name().map(str::to_string),
+        kind: match light.kind() {
+            Kind::Directional => LightKind::Directional,
+            Kind::Point => LightKind::Point,
+            Kind::Spot {
+                inner_cone_angle,
+                outer_cone_angle,
+            } => LightKind::Spot {
+                inner_cone: inner_cone_angle,
+                outer_cone: outer_cone_angle,
+            },
+        },
+        position: world.transform_point3(Vec3::ZERO),
+        direction: world.transform_vector3(-Vec3::Z).normalize_or(-Vec3::Z),
+        color: Vec3::from(light.color()),
+        intensity: light.intensity(),
+        range: light.range(),
+    }
 }
 
 fn add_mesh(
@@ -460,23 +343,28 @@ fn add_mesh(
                 b.normals.extend(std::iter::repeat_n(None, count));
             }
         }
-        match reader.read_tex_coords(0) {
-            Some(t) => {
-                // glTF puts v = 0 at the top of the image; lodeval uses the OpenGL convention (bottom).
-                let t: Vec<Option<Vec2>> = t
-                    .into_f32()
-                    .map(|t| Some(Vec2::new(t[0], 1.0 - t[1])))
-                    .collect();
-                attr_len(t.len(), "TEXCOORD_0")?;
-                b.uvs.extend(t);
+        for (set, out) in [(0, &mut b.uvs), (1, &mut b.uvs1)] {
+            match reader.read_tex_coords(set) {
+                Some(t) => {
+                    // glTF puts v = 0 at the top of the image; lodeval uses the OpenGL
+                    // convention (bottom).
+                    let t: Vec<Option<Vec2>> = t
+                        .into_f32()
+                        .map(|t| Some(Vec2::new(t[0], 1.0 - t[1])))
+                        .collect();
+                    attr_len(t.len(), &format!("TEXCOORD_{set}"))?;
+                    out.extend(t);
+                }
+                None => out.extend(std::iter::repeat_n(None, count)),
             }
-            None => b.uvs.extend(std::iter::repeat_n(None, count)),
         }
         match reader.read_colors(0) {
             Some(c) => {
-                let c: Vec<Option<Vec3>> = c.into_rgb_f32().map(|c| Some(Vec3::from(c))).collect();
+                let c: Vec<[f32; 4]> = c.into_rgba_f32().collect();
                 attr_len(c.len(), "COLOR_0")?;
-                b.colors.extend(c);
+                b.color_alpha |= c.iter().any(|c| c[3] < 1.0);
+                b.colors
+                    .extend(c.iter().map(|c| Some(Vec3::new(c[0], c[1], c[2]))));
             }
             None => b.colors.extend(std::iter::repeat_n(None, count)),
         }

@@ -25,7 +25,11 @@ mod bounds;
 pub mod edit;
 mod gltf;
 mod gltf_check;
+mod gltf_material;
 mod incidence;
+mod material;
+mod material_check;
+mod mtl;
 mod normals;
 mod obj;
 mod off;
@@ -33,22 +37,26 @@ mod ply;
 pub mod shapes;
 mod summary;
 pub mod surface_distance;
+pub mod tangents;
 mod texture;
 mod validate;
 mod weld;
 pub mod write_gltf;
+mod write_gltf_material;
 pub mod write_obj;
 
 use std::path::{Path, PathBuf};
-use std::sync::Arc;
 
 use glam::{Vec2, Vec3};
 
 use crate::error::{Error, Result};
 
 pub use bounds::{Aabb, Sphere};
+pub use material::{
+    AlphaMode, Filter, Material, Model, Sampler, TextureSlot, TextureTransform, Wrap,
+};
 pub use summary::{Attributes, MaterialSummary, MeshSummary, TextureSummary};
-pub use texture::{ColorSpace, Texture};
+pub use texture::{ColorSpace, EncodedImage, Texture};
 
 /// The file formats lodeval reads.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
@@ -125,49 +133,40 @@ impl Default for LoadOptions {
     }
 }
 
-/// A surface material, reduced to what lodeval's shading models use.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Material {
-    /// Name from the file (MTL `newmtl`, glTF material name), or `"default"`.
-    pub name: String,
-    /// Linear RGB base (diffuse) colour, multiplied with the base-colour texture.
-    pub base_color: Vec3,
-    /// Base-colour (albedo) texture, sRGB.
-    pub base_color_texture: Option<Arc<Texture>>,
-    /// Tangent-space normal map, linear.
-    pub normal_texture: Option<Arc<Texture>>,
-    /// Linear RGB specular colour (Blinn–Phong).
-    pub specular: Vec3,
-    /// Blinn–Phong exponent.
-    pub shininess: f32,
+/// The kind of a light a file declares (`KHR_lights_punctual`).
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum LightKind {
+    /// Infinitely far, along `direction`; intensity in lux.
+    Directional,
+    /// At `position`, in every direction; intensity in candela.
+    Point,
+    /// At `position`, a cone about `direction`; intensity in candela.
+    Spot {
+        /// Angle from the axis, radians, inside which the intensity is full.
+        inner_cone: f32,
+        /// Angle from the axis, radians, outside which there is no light.
+        outer_cone: f32,
+    },
 }
 
-impl Material {
-    /// Blinn–Phong parameters for a metallic–roughness material (glTF, nvdiffrec MTL):
-    /// specular colour = mix(0.04, base colour, metallic), exponent = 2/α² − 2 with α = roughness²
-    /// (the Beckmann–Phong correspondence; Walter et al. 2007, eq. 30), clamped to 1..10 000.
-    pub fn specular_from_metallic_roughness(
-        base_color: Vec3,
-        metallic: f32,
-        roughness: f32,
-    ) -> (Vec3, f32) {
-        let alpha = roughness.clamp(0.03, 1.0).powi(2);
-        let specular = Vec3::splat(0.04).lerp(base_color, metallic.clamp(0.0, 1.0));
-        (specular, (2.0 / (alpha * alpha) - 2.0).clamp(1.0, 10_000.0))
-    }
-
-    /// The material given to triangles the file assigns none: light grey diffuse with a faint
-    /// highlight, so shape reads clearly under the default headlight.
-    pub fn default_material() -> Material {
-        Material {
-            name: "default".into(),
-            base_color: Vec3::splat(0.8),
-            base_color_texture: None,
-            normal_texture: None,
-            specular: Vec3::splat(0.1),
-            shininess: 32.0,
-        }
-    }
+/// A light a file declares, in world space (its node's transform applied).
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct FileLight {
+    /// The light's name in the file.
+    pub name: Option<String>,
+    /// Its kind.
+    pub kind: LightKind,
+    /// Position (point and spot lights).
+    pub position: Vec3,
+    /// The direction the light travels (directional and spot lights): the node's −Z.
+    pub direction: Vec3,
+    /// Linear RGB colour.
+    pub color: Vec3,
+    /// Intensity (lux or candela, by kind).
+    pub intensity: f32,
+    /// Distance beyond which the light is zero, if given.
+    pub range: Option<f32>,
 }
 
 /// Where a mesh came from and what the file itself declared.
@@ -191,6 +190,18 @@ pub struct Source {
     /// Every file read to build the mesh: the mesh file, its material libraries, textures, glTF
     /// buffers and images. Nothing lodeval writes may be one of them.
     pub files: Vec<PathBuf>,
+    /// The scene nodes whose meshes were merged into this one (glTF), with the world transforms
+    /// the loader applied to their vertices; empty for formats without nodes.
+    pub nodes: Vec<SourceNode>,
+}
+
+/// A glTF node whose mesh the loader merged, and the world transform it applied.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct SourceNode {
+    /// The node's name, or `node N` where it has none.
+    pub name: String,
+    /// Its world transform (column-major), applied to the vertices on load.
+    pub world: glam::Mat4,
 }
 
 /// A mesh as a loader produced it, before validation. Every field is plain data; [`Mesh::new`]
@@ -201,8 +212,10 @@ pub struct MeshData {
     pub positions: Vec<Vec3>,
     /// Per-vertex normals, if the file has them (need not be unit length).
     pub normals: Option<Vec<Vec3>>,
-    /// Per-vertex texture coordinates.
+    /// Per-vertex texture coordinates (`TEXCOORD_0`; OBJ `vt`).
     pub uvs: Option<Vec<Vec2>>,
+    /// A second texture coordinate set (`TEXCOORD_1`), for slots that name it.
+    pub uvs1: Option<Vec<Vec2>>,
     /// Per-vertex linear RGB colours.
     pub colors: Option<Vec<Vec3>>,
     /// Triangles as vertex indices, counter-clockwise front faces.
@@ -211,6 +224,8 @@ pub struct MeshData {
     pub material_ids: Vec<u32>,
     /// Materials; if empty, one default material is added.
     pub materials: Vec<Material>,
+    /// Lights the file declares (glTF `KHR_lights_punctual`).
+    pub lights: Vec<FileLight>,
     /// Provenance.
     pub source: Source,
     /// Non-fatal problems the loader met (e.g. a missing texture under [`MissingAssets::Warn`]).
@@ -232,10 +247,12 @@ pub struct Mesh {
     positions: Vec<Vec3>,
     normals: Vec<Vec3>,
     uvs: Option<Vec<Vec2>>,
+    uvs1: Option<Vec<Vec2>>,
     colors: Option<Vec<Vec3>>,
     triangles: Vec<[u32; 3]>,
     material_ids: Vec<u32>,
     materials: Vec<Material>,
+    lights: Vec<FileLight>,
     weld: Vec<u32>,
     welded_count: usize,
     degenerate: usize,
@@ -275,10 +292,12 @@ impl Mesh {
             positions: data.positions,
             normals,
             uvs: data.uvs,
+            uvs1: data.uvs1,
             colors: data.colors,
             triangles: data.triangles,
             material_ids: data.material_ids,
             materials: data.materials,
+            lights: data.lights,
             weld,
             welded_count,
             degenerate: report.degenerate_triangles,
@@ -298,10 +317,12 @@ impl Mesh {
             positions: self.positions.clone(),
             normals: self.normals_from_file.then(|| self.normals.clone()),
             uvs: self.uvs.clone(),
+            uvs1: self.uvs1.clone(),
             colors: self.colors.clone(),
             triangles: self.triangles.clone(),
             material_ids: self.material_ids.clone(),
             materials: self.materials.clone(),
+            lights: self.lights.clone(),
             source: Source {
                 edited: true,
                 ..self.source.clone()
@@ -322,6 +343,18 @@ impl Mesh {
     pub fn uvs(&self) -> Option<&[Vec2]> {
         self.uvs.as_deref()
     }
+    /// The second texture coordinate set (`TEXCOORD_1`), if the file has it.
+    pub fn uvs1(&self) -> Option<&[Vec2]> {
+        self.uvs1.as_deref()
+    }
+    /// Texture coordinate set `set` (0 or 1), if the mesh has it.
+    pub fn uv_set(&self, set: u32) -> Option<&[Vec2]> {
+        match set {
+            0 => self.uvs(),
+            1 => self.uvs1(),
+            _ => None,
+        }
+    }
     /// Linear RGB vertex colours, if the file has them.
     pub fn colors(&self) -> Option<&[Vec3]> {
         self.colors.as_deref()
@@ -337,6 +370,10 @@ impl Mesh {
     /// Materials (at least one).
     pub fn materials(&self) -> &[Material] {
         &self.materials
+    }
+    /// Lights the file declares, world space.
+    pub fn lights(&self) -> &[FileLight] {
+        &self.lights
     }
     /// Number of vertices (after seam splitting).
     pub fn vertex_count(&self) -> usize {

@@ -210,10 +210,12 @@ mod tests {
             positions: vec![Vec3::ZERO, Vec3::X, Vec3::Y, Vec3::Z],
             normals: None,
             uvs: None,
+            uvs1: None,
             colors: None,
             triangles: vec![[0, 2, 1], [0, 1, 3], [0, 3, 2]],
             material_ids: vec![],
             materials: vec![],
+            lights: Vec::new(),
             source: Source {
                 path: Default::default(),
                 format: Format::Obj,
@@ -222,6 +224,7 @@ mod tests {
                 file_unreferenced: 0,
                 edited: false,
                 files: Vec::new(),
+                nodes: Vec::new(),
             },
             warnings: vec![],
         }

@@ -12,9 +12,8 @@
 //!
 //! Decisions: `l` and `p` records (lines, points) are ignored; polygons are fan-triangulated by
 //! `tobj`; OBJ vertex colours are taken as sRGB-encoded values in 0..1 and linearised; `map_Bump`,
-//! `bump` and `norm` all name a tangent-space normal map; an MTL material with nvdiffrec's
-//! `bsdf pbr` line stores (occlusion, roughness, metallic) in `Ks`, not a specular colour (Spot
-//! and Bob from nvdiffrec would otherwise get a green highlight).
+//! `bump` and `norm` all name a tangent-space normal map. Each MTL material is mapped by
+//! `mtl.rs` (Blinn–Phong keys, and the PBR extension keys where present).
 
 use std::collections::HashMap;
 use std::io::Cursor;
@@ -22,7 +21,7 @@ use std::path::{Path, PathBuf};
 
 use glam::{Vec2, Vec3};
 
-use super::texture::{ColorSpace, TextureCache, resolve_asset_path};
+use super::texture::{TextureCache, resolve_asset_path};
 use super::{Format, LoadOptions, Material, MeshData, MissingAssets, Source, read_file};
 use crate::color::srgb_to_linear;
 use crate::error::{Error, Location, Result};
@@ -478,57 +477,12 @@ pub(crate) fn load(path: &Path, options: &LoadOptions) -> Result<MeshData> {
             .find_map(|p| p.parent())
             .unwrap_or(&dir)
             .to_path_buf();
-        let mut mat = Material::default_material();
-        mat.name = m.name.clone();
-        if let Some(kd) = m.diffuse {
-            mat.base_color = Vec3::from(kd);
-        }
-        let nvdiffrec_pbr = m
-            .unknown_param
-            .get("bsdf")
-            .is_some_and(|b| b.trim() == "pbr");
-        match (m.specular, nvdiffrec_pbr) {
-            // nvdiffrec's `bsdf pbr` MTL files store (occlusion, roughness, metallic) in Ks.
-            (Some([_, roughness, metallic]), true) => {
-                (mat.specular, mat.shininess) =
-                    Material::specular_from_metallic_roughness(mat.base_color, metallic, roughness);
-            }
-            (Some(ks), false) => mat.specular = Vec3::from(ks),
-            (None, _) => {}
-        }
-        if let (Some(ns), false) = (m.shininess, nvdiffrec_pbr) {
-            mat.shininess = ns.max(1.0);
-        }
-        let normal_name = m
-            .normal_texture
-            .clone()
-            .or_else(|| m.unknown_param.get("norm").cloned());
-        let wanted = [
-            (m.diffuse_texture.clone(), ColorSpace::Srgb),
-            (normal_name, ColorSpace::Linear),
-        ];
-        for (slot, (name, space)) in wanted.into_iter().enumerate() {
-            let Some(name) = name.filter(|n| !n.trim().is_empty()) else {
-                continue;
-            };
-            let tex_path = resolve_asset_path(&mtl_dir, &name);
-            let referrer = mtl_dir.join(format!("(material '{}')", m.name));
-            match cache.load(&tex_path, space, &referrer) {
-                Ok(t) if slot == 0 => mat.base_color_texture = Some(t),
-                Ok(t) => mat.normal_texture = Some(t),
-                Err(e) => match options.missing_assets {
-                    MissingAssets::Error => {
-                        return Err(Error::input_at(
-                            path,
-                            Location::Element(format!("material '{}'", m.name)),
-                            format!("texture problem: {e}"),
-                            "",
-                        ));
-                    }
-                    MissingAssets::Warn => warnings.push(format!("material '{}': {e}", m.name)),
-                },
-            }
-        }
+        let ctx = super::mtl::MtlContext {
+            obj: path,
+            dir: &mtl_dir,
+            options,
+        };
+        let mat = super::mtl::material(m, &ctx, &mut cache, &mut warnings)?;
         out_materials.push(mat);
     }
     let default_id = out_materials.len() as u32;
@@ -613,10 +567,12 @@ pub(crate) fn load(path: &Path, options: &LoadOptions) -> Result<MeshData> {
         positions,
         normals: has_n.then_some(normals),
         uvs: has_uv.then_some(uvs),
+        uvs1: None,
         colors: has_c.then_some(colors),
         triangles,
         material_ids,
         materials: out_materials,
+        lights: Vec::new(),
         source: Source {
             path: path.to_path_buf(),
             format: Format::Obj,
@@ -625,6 +581,7 @@ pub(crate) fn load(path: &Path, options: &LoadOptions) -> Result<MeshData> {
             file_unreferenced: scan.unreferenced,
             edited: false,
             files,
+            nodes: Vec::new(),
         },
         warnings,
     })

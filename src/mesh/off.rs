@@ -155,10 +155,12 @@ pub(crate) fn load(path: &Path) -> Result<MeshData> {
         positions,
         normals: has_n.then_some(normals),
         uvs: None,
+        uvs1: None,
         colors: has_c.then_some(colors),
         triangles,
         material_ids: vec![],
         materials: vec![],
+        lights: Vec::new(),
         source: Source {
             path: path.to_path_buf(),
             format: Format::Off,
@@ -167,6 +169,7 @@ pub(crate) fn load(path: &Path) -> Result<MeshData> {
             file_unreferenced: 0,
             edited: false,
             files: vec![path.to_path_buf()],
+            nodes: Vec::new(),
         },
         warnings: vec![],
     })

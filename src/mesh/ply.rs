@@ -211,10 +211,12 @@ pub(crate) fn load(path: &Path) -> Result<MeshData> {
         positions,
         normals: has_n.then_some(normals),
         uvs: uv_keys.map(|_| uvs),
+        uvs1: None,
         colors: color_keys.map(|_| colors),
         triangles,
         material_ids: vec![],
         materials: vec![],
+        lights: Vec::new(),
         source: Source {
             path: path.to_path_buf(),
             format: Format::Ply,
@@ -223,6 +225,7 @@ pub(crate) fn load(path: &Path) -> Result<MeshData> {
             file_unreferenced: 0,
             edited: false,
             files: vec![path.to_path_buf()],
+            nodes: Vec::new(),
         },
         warnings: vec![],
     })

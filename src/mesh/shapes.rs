@@ -16,10 +16,12 @@ fn finish(name: &str, positions: Vec<Vec3>, triangles: Vec<[u32; 3]>) -> Mesh {
         positions,
         normals: None,
         uvs: None,
+        uvs1: None,
         colors: None,
         triangles,
         material_ids: vec![],
         materials: vec![],
+        lights: Vec::new(),
         source: Source {
             path: PathBuf::from(format!("<{name}>")),
             format: Format::Obj,
@@ -28,6 +30,7 @@ fn finish(name: &str, positions: Vec<Vec3>, triangles: Vec<[u32; 3]>) -> Mesh {
             file_unreferenced: 0,
             edited: false,
             files: Vec::new(),
+            nodes: Vec::new(),
         },
         warnings: vec![],
     };

@@ -7,8 +7,11 @@ use super::{Aabb, ColorSpace, Format, Mesh, Sphere};
 /// One texture as `info` reports it.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct TextureSummary {
-    /// `base_color` or `normal`.
+    /// The slot, by its glTF name (`baseColorTexture`, `metallicRoughnessTexture`,
+    /// `normalTexture`, `occlusionTexture`, `emissiveTexture`).
     pub role: &'static str,
+    /// The texture coordinate set it reads.
+    pub tex_coord: u32,
     /// File path or embedded-image label.
     pub source: String,
     /// Width in texels.
@@ -26,8 +29,20 @@ pub struct MaterialSummary {
     pub name: String,
     /// Triangles that use it.
     pub triangles: usize,
+    /// The reflectance model the file described.
+    pub model: super::Model,
     /// Linear RGB base colour.
     pub base_color: [f32; 3],
+    /// Metallic factor.
+    pub metallic: f32,
+    /// Roughness factor.
+    pub roughness: f32,
+    /// Emitted radiance factor (emissive × strength).
+    pub emission: [f32; 3],
+    /// Alpha mode.
+    pub alpha_mode: super::AlphaMode,
+    /// Double-sided.
+    pub double_sided: bool,
     /// Textures it uses.
     pub textures: Vec<TextureSummary>,
 }
@@ -39,6 +54,8 @@ pub struct Attributes {
     pub normals_from_file: bool,
     /// Texture coordinates.
     pub uvs: bool,
+    /// A second texture coordinate set.
+    pub uvs1: bool,
     /// Vertex colours.
     pub colors: bool,
 }
@@ -90,25 +107,30 @@ impl MeshSummary {
             .iter()
             .zip(per_material)
             .map(|(m, triangles)| {
-                let textures = [
-                    ("base_color", &m.base_color_texture),
-                    ("normal", &m.normal_texture),
-                ]
-                .into_iter()
-                .filter_map(|(role, t)| {
-                    t.as_ref().map(|t| TextureSummary {
-                        role,
-                        source: t.label().to_string(),
-                        width: t.width(),
-                        height: t.height(),
-                        color_space: t.color_space(),
+                let textures = m
+                    .slots()
+                    .into_iter()
+                    .filter_map(|(role, slot)| {
+                        slot.map(|s| TextureSummary {
+                            role,
+                            tex_coord: s.set(),
+                            source: s.texture.label().to_string(),
+                            width: s.texture.width(),
+                            height: s.texture.height(),
+                            color_space: s.texture.color_space(),
+                        })
                     })
-                })
-                .collect();
+                    .collect();
                 MaterialSummary {
                     name: m.name.clone(),
                     triangles,
+                    model: m.model,
                     base_color: m.base_color.to_array(),
+                    metallic: m.metallic,
+                    roughness: m.roughness,
+                    emission: m.emission().to_array(),
+                    alpha_mode: m.alpha_mode,
+                    double_sided: m.double_sided,
                     textures,
                 }
             })
@@ -127,6 +149,7 @@ impl MeshSummary {
             attributes: Attributes {
                 normals_from_file: mesh.normals_from_file(),
                 uvs: mesh.uvs().is_some(),
+                uvs1: mesh.uvs1().is_some(),
                 colors: mesh.colors().is_some(),
             },
             materials,
@@ -164,9 +187,14 @@ impl std::fmt::Display for MeshSummary {
         }
         writeln!(
             f,
-            "attributes           normals from file: {}, uvs: {}, colours: {}",
+            "attributes           normals from file: {}, uvs: {}{}, colours: {}",
             yes(self.attributes.normals_from_file),
             yes(self.attributes.uvs),
+            if self.attributes.uvs1 {
+                " (+ a second set)"
+            } else {
+                ""
+            },
             yes(self.attributes.colors)
         )?;
         let (lo, hi) = (self.aabb.min, self.aabb.max);
@@ -185,11 +213,36 @@ impl std::fmt::Display for MeshSummary {
         writeln!(f, "materials            {}", self.materials.len())?;
         for m in &self.materials {
             writeln!(f, "  {:<18} {} triangles", m.name, m.triangles)?;
+            let c = m.base_color;
+            match m.model {
+                super::Model::MetallicRoughness => writeln!(
+                    f,
+                    "    metallic–roughness: base [{:.3}, {:.3}, {:.3}], metallic {:.3}, roughness {:.3}",
+                    c[0], c[1], c[2], m.metallic, m.roughness
+                )?,
+                super::Model::BlinnPhong => writeln!(
+                    f,
+                    "    Blinn–Phong: diffuse [{:.3}, {:.3}, {:.3}]",
+                    c[0], c[1], c[2]
+                )?,
+            }
+            if m.emission.iter().any(|&e| e > 0.0) {
+                let e = m.emission;
+                writeln!(f, "    emission [{:.3}, {:.3}, {:.3}]", e[0], e[1], e[2])?;
+            }
+            if m.alpha_mode != super::AlphaMode::Opaque || m.double_sided {
+                writeln!(
+                    f,
+                    "    alpha {:?}{}",
+                    m.alpha_mode,
+                    if m.double_sided { ", double-sided" } else { "" }
+                )?;
+            }
             for t in &m.textures {
                 writeln!(
                     f,
-                    "    {:<10} {}x{} {}",
-                    t.role, t.width, t.height, t.source
+                    "    {:<24} {}x{} TEXCOORD_{} {}",
+                    t.role, t.width, t.height, t.tex_coord, t.source
                 )?;
             }
         }

@@ -24,6 +24,37 @@ pub enum ColorSpace {
     Linear,
 }
 
+/// The file bytes a texture was decoded from, kept so that an exporter writes the image as the
+/// input had it (a JPEG stays the same JPEG; a 16-bit PNG keeps its 16 bits).
+#[derive(Debug, Clone, PartialEq)]
+pub struct EncodedImage {
+    /// The encoded bytes.
+    pub bytes: Arc<[u8]>,
+    /// `image/png` or `image/jpeg`.
+    pub mime: &'static str,
+    /// The image's name in the file (glTF `images[i].name`), or its file stem.
+    pub name: Option<String>,
+}
+
+impl EncodedImage {
+    /// The encoded image for `bytes` if they are a PNG or a JPEG (by their signature), else
+    /// `None` (the exporter then writes the decoded texels as PNG).
+    pub fn sniff(bytes: &[u8], name: Option<String>) -> Option<EncodedImage> {
+        let mime = if bytes.starts_with(b"\x89PNG\r\n\x1a\n") {
+            "image/png"
+        } else if bytes.starts_with(&[0xff, 0xd8, 0xff]) {
+            "image/jpeg"
+        } else {
+            return None;
+        };
+        Some(EncodedImage {
+            bytes: bytes.into(),
+            mime,
+            name,
+        })
+    }
+}
+
 /// A decoded texture.
 ///
 /// # Guarantees
@@ -35,6 +66,7 @@ pub struct Texture {
     height: u32,
     rgba: Vec<u8>,
     space: ColorSpace,
+    encoded: Option<EncodedImage>,
 }
 
 impl Texture {
@@ -56,7 +88,24 @@ impl Texture {
             height,
             rgba,
             space,
+            encoded: None,
         })
+    }
+
+    /// The texture with the file bytes it was decoded from.
+    pub fn with_encoded(mut self, encoded: Option<EncodedImage>) -> Texture {
+        self.encoded = encoded;
+        self
+    }
+
+    /// The file bytes the texture was decoded from, where they were kept.
+    pub fn encoded(&self) -> Option<&EncodedImage> {
+        self.encoded.as_ref()
+    }
+
+    /// Whether any texel's alpha is below 255.
+    pub fn has_alpha(&self) -> bool {
+        self.rgba.chunks_exact(4).any(|p| p[3] < 255)
     }
 
     /// Where the texture came from (a path, or a glTF image index).
@@ -80,14 +129,17 @@ impl Texture {
         self.space
     }
 
-    /// Decode an in-memory image (PNG or JPEG).
+    /// Decode an in-memory image (PNG or JPEG), keeping its bytes for export.
     pub fn decode(
         label: &str,
         bytes: &[u8],
         space: ColorSpace,
     ) -> std::result::Result<Texture, String> {
         let img = image::load_from_memory(bytes).map_err(|e| e.to_string())?;
-        Texture::from_image(label, img, space)
+        let name = std::path::Path::new(label)
+            .file_stem()
+            .map(|s| s.to_string_lossy().into_owned());
+        Ok(Texture::from_image(label, img, space)?.with_encoded(EncodedImage::sniff(bytes, name)))
     }
 
     /// Convert a decoded `image` into a texture.

@@ -47,6 +47,10 @@ pub(crate) fn check(data: &MeshData) -> Result<Report> {
     let lengths = [
         ("normal", data.normals.as_ref().map(Vec::len)),
         ("texture coordinate", data.uvs.as_ref().map(Vec::len)),
+        (
+            "second texture coordinate",
+            data.uvs1.as_ref().map(Vec::len),
+        ),
         ("colour", data.colors.as_ref().map(Vec::len)),
     ];
     for (what, len) in lengths {
@@ -84,15 +88,16 @@ pub(crate) fn check(data: &MeshData) -> Result<Report> {
         let fix = "remove the normals to let lodeval compute them, or re-export the mesh";
         return non_finite("normal", v, fmt_vec(normals[v]), fix);
     }
-    let uvs = data.uvs.as_deref().unwrap_or_default();
-    if let Some(v) = uvs.iter().position(|p| !p.is_finite()) {
-        return non_finite(
-            "texture coordinate",
-            v,
-            format!("({}, {})", uvs[v].x, uvs[v].y),
-            REEXPORT,
-        );
+    for (what, uvs) in [
+        ("texture coordinate", &data.uvs),
+        ("second texture coordinate", &data.uvs1),
+    ] {
+        let uvs = uvs.as_deref().unwrap_or_default();
+        if let Some(v) = uvs.iter().position(|p| !p.is_finite()) {
+            return non_finite(what, v, format!("({}, {})", uvs[v].x, uvs[v].y), REEXPORT);
+        }
     }
+    super::material_check::check(path, &data.materials)?;
     let colors = data.colors.as_deref().unwrap_or_default();
     if let Some(v) = colors.iter().position(|p| !p.is_finite()) {
         return non_finite("colour", v, fmt_vec(colors[v]), REEXPORT);
@@ -226,6 +231,9 @@ pub(crate) fn compact_unreferenced(data: &mut MeshData) -> usize {
     if let Some(v) = data.uvs.as_mut() {
         keep(v, &new_index);
     }
+    if let Some(v) = data.uvs1.as_mut() {
+        keep(v, &new_index);
+    }
     if let Some(v) = data.colors.as_mut() {
         keep(v, &new_index);
     }
@@ -260,10 +268,12 @@ mod tests {
             positions: vec![Vec3::ZERO, Vec3::X, Vec3::Y, Vec3::Z],
             normals: None,
             uvs: None,
+            uvs1: None,
             colors: None,
             triangles: vec![[0, 2, 1], [0, 1, 3], [1, 2, 3], [0, 3, 2]],
             material_ids: vec![],
             materials: vec![],
+            lights: Vec::new(),
             source: Source {
                 path: PathBuf::from("t.obj"),
                 format: Format::Obj,
@@ -272,6 +282,7 @@ mod tests {
                 file_unreferenced: 0,
                 edited: false,
                 files: Vec::new(),
+                nodes: Vec::new(),
             },
             warnings: vec![],
         }

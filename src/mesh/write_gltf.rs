@@ -14,20 +14,26 @@
 //! - One mesh per level, one primitive per material it uses; levels share materials, textures and
 //!   images (the same material written once). Only the finest level's node is in the scene (the
 //!   others are reached through the extension), so a reader without `MSFT_lod` shows the original.
-//! - Texture coordinates are flipped back to glTF's top-left origin (the loader flipped them).
-//! - lodeval's materials are Blinn–Phong; they go back to metallic–roughness by inverting the
-//!   loader's mapping: roughness = (2 / (n + 2))^¼ for the exponent n, metallic from where the
-//!   specular colour lies between 0.04 and the base colour. Base colour, its texture and the
-//!   normal map are kept exactly; a glTF input's own metallic–roughness texture is not kept.
+//! - Materials are written whole by `write_gltf_material.rs` (every slot, sampler, transform and
+//!   kept extension; images as the bytes they were read from).
+//! - Attributes: POSITION, NORMAL, TEXCOORD_0 and TEXCOORD_1 (flipped back to glTF's top-left
+//!   origin; the loader flipped them), COLOR_0 (linear RGB), and TANGENT for meshes with normal
+//!   maps: the tangents lodeval itself normal-maps with (`tangents.rs`), so an engine shades
+//!   the LOD as it was measured.
+//! - Nodes: the loader applies node transforms to the vertices. Where every merged node shared one
+//!   transform (the usual one-node asset), the chain is written under a node of that name and
+//!   transform, with the vertices taken back into its space; otherwise the merge is a warning.
+//!   The file's `KHR_lights_punctual` lights are written as nodes of the scene.
+//! - Side files (`.bin`, images) are written before the `.gltf` that names them.
 
 use std::borrow::Cow;
-use std::path::Path;
-use std::sync::Arc;
+use std::path::{Path, PathBuf};
 
-use glam::Vec3;
+use glam::{Mat3, Mat4, Vec3};
 use serde_json::{Value, json};
 
-use super::{Material, Mesh, Texture};
+use super::write_gltf_material::{ImageOut, Materials};
+use super::{LightKind, Mesh};
 use crate::error::{Error, Result};
 
 /// Byte offset alignment of buffer views.
@@ -101,135 +107,131 @@ impl Buffer {
     }
 }
 
-/// Materials and their textures, each written once however many levels use them.
-#[derive(Default)]
-struct Materials {
-    written: Vec<Material>,
-    json: Vec<Value>,
-    textures: Vec<(Arc<Texture>, usize)>,
-    /// PNG bytes per image (texture k uses image k).
-    pngs: Vec<Vec<u8>>,
-    texture_json: Vec<Value>,
+/// What a chain export wrote: every file, and what it could not carry from the input.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Written {
+    /// Every file written (the `.glb`, or the `.gltf` with its `.bin` and images).
+    pub files: Vec<PathBuf>,
+    /// What the input had that the export does not carry, one line each.
+    pub warnings: Vec<String>,
 }
 
-impl Materials {
-    /// The glTF texture index of `t`, its PNG added to the buffer the first time.
-    fn texture(&mut self, t: &Arc<Texture>) -> Result<usize> {
-        if let Some((_, i)) = self.textures.iter().find(|(x, _)| Arc::ptr_eq(x, t)) {
-            return Ok(*i);
-        }
-        let img = image::RgbaImage::from_raw(t.width(), t.height(), t.rgba().to_vec())
-            .ok_or_else(|| Error::Internal("glTF export: texture size".into()))?;
-        let mut png = Vec::new();
-        image::DynamicImage::ImageRgba8(img)
-            .write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png)
-            .map_err(|e| Error::Internal(format!("glTF export: PNG: {e}")))?;
-        self.pngs.push(png);
-        self.texture_json
-            .push(json!({ "source": self.pngs.len() - 1 }));
-        let i = self.texture_json.len() - 1;
-        self.textures.push((t.clone(), i));
-        Ok(i)
-    }
-
-    /// The glTF material index of `m`.
-    fn material(&mut self, m: &Material) -> Result<usize> {
-        let same = |a: &Material| {
-            let tex = |x: &Option<Arc<Texture>>, y: &Option<Arc<Texture>>| match (x, y) {
-                (Some(x), Some(y)) => Arc::ptr_eq(x, y),
-                (None, None) => true,
-                _ => false,
-            };
-            a.name == m.name
-                && a.base_color == m.base_color
-                && a.specular == m.specular
-                && a.shininess == m.shininess
-                && tex(&a.base_color_texture, &m.base_color_texture)
-                && tex(&a.normal_texture, &m.normal_texture)
-        };
-        if let Some(i) = self.written.iter().position(same) {
-            return Ok(i);
-        }
-        let (metallic, roughness) = metallic_roughness(m);
-        let c = m.base_color;
-        let mut pbr = json!({
-            "baseColorFactor": [c.x, c.y, c.z, 1.0],
-            "metallicFactor": metallic,
-            "roughnessFactor": roughness,
-        });
-        if let Some(t) = &m.base_color_texture {
-            pbr["baseColorTexture"] = json!({ "index": self.texture(t)? });
-        }
-        let mut mat = json!({ "name": m.name, "pbrMetallicRoughness": pbr });
-        if let Some(t) = &m.normal_texture {
-            mat["normalTexture"] = json!({ "index": self.texture(t)? });
-        }
-        self.json.push(mat);
-        self.written.push(m.clone());
-        Ok(self.written.len() - 1)
-    }
+/// The node transform a chain is written under: the one world transform every merged node of
+/// the finest level shared (the vertices go back to that node's space), or none.
+fn shared_transform(mesh: &Mesh) -> Option<(String, Mat4)> {
+    let nodes = &mesh.source().nodes;
+    let first = nodes.first()?;
+    let invertible = first.world.determinant().abs() > f32::MIN_POSITIVE;
+    (invertible && first.world != Mat4::IDENTITY && nodes.iter().all(|n| n.world == first.world))
+        .then(|| (first.name.clone(), first.world))
 }
 
-/// Metallic and roughness for a Blinn–Phong material (the inverse of the loader's mapping).
-pub fn metallic_roughness(m: &Material) -> (f32, f32) {
-    let alpha = (2.0 / (m.shininess.max(1.0) + 2.0)).sqrt();
-    let roughness = alpha.sqrt().clamp(0.0, 1.0);
-    // specular = 0.04 + (base − 0.04)·metallic, per channel; the mean over channels with room.
-    let (mut sum, mut n) = (0.0, 0);
-    for k in 0..3 {
-        let span = m.base_color[k] - 0.04;
-        if span.abs() > 0.05 {
-            sum += ((m.specular[k] - 0.04) / span).clamp(0.0, 1.0);
-            n += 1;
-        }
+/// A node named `name` with transform `world`: translation, rotation and scale where they compose
+/// back to it (the usual node), else the matrix.
+fn transform_node(name: &str, world: &Mat4) -> Value {
+    let (scale, rotation, translation) = world.to_scale_rotation_translation();
+    let trs = Mat4::from_scale_rotation_translation(scale, rotation, translation);
+    let largest = world
+        .abs()
+        .to_cols_array()
+        .iter()
+        .fold(1.0f32, |a, &b| a.max(b));
+    if !trs.abs_diff_eq(*world, 1e-6 * largest) {
+        return json!({ "name": name, "matrix": world.to_cols_array(), "children": [0] });
     }
-    (if n > 0 { sum / n as f32 } else { 0.0 }, roughness)
+    let mut node = json!({ "name": name, "children": [0] });
+    if translation != Vec3::ZERO {
+        node["translation"] = json!(translation.to_array());
+    }
+    if rotation != glam::Quat::IDENTITY {
+        node["rotation"] = json!(rotation.to_array());
+    }
+    if scale != Vec3::ONE {
+        node["scale"] = json!(scale.to_array());
+    }
+    node
 }
 
-/// Write `levels` (finest first, each with its name) as one glTF asset at `path` (`.glb` or
-/// `.gltf`), linked by `MSFT_lod`, with `coverage` (one value per level, non-increasing, the last
-/// usually 0) as `MSFT_screencoverage`. Returns every file written.
-pub fn write_lod_chain(
+/// The image file names beside a `.gltf` (`STEM-NAME.EXT`, made unique).
+fn image_files(stem: &str, images: &[ImageOut]) -> Vec<String> {
+    let mut used = std::collections::BTreeSet::new();
+    images
+        .iter()
+        .map(|im| {
+            let base: String = im
+                .name
+                .chars()
+                .map(|c| {
+                    if c.is_ascii_alphanumeric() || "-_.".contains(c) {
+                        c
+                    } else {
+                        '_'
+                    }
+                })
+                .collect();
+            let mut name = format!("{stem}-{base}.{}", im.extension());
+            let mut k = 1;
+            while !used.insert(name.clone()) {
+                name = format!("{stem}-{base}-{k}.{}", im.extension());
+                k += 1;
+            }
+            name
+        })
+        .collect()
+}
+
+/// One mesh per level, one primitive per material it uses, attributes in `space` (the inverse
+/// of the shared node transform, or the identity).
+fn level_meshes(
     levels: &[(&str, &Mesh)],
-    coverage: &[f64],
-    path: &Path,
-) -> Result<Vec<std::path::PathBuf>> {
-    let ext = path.extension().and_then(|e| e.to_str()).unwrap_or("");
-    if ext != "glb" && ext != "gltf" {
-        return Err(Error::Usage(format!(
-            "{}: a glTF LOD chain is written as .glb or .gltf",
-            path.display()
-        )));
-    }
-    if levels.is_empty() || coverage.len() != levels.len() {
-        return Err(Error::Internal(format!(
-            "glTF export: {} levels and {} coverage values",
-            levels.len(),
-            coverage.len()
-        )));
-    }
-    if coverage.iter().any(|c| !c.is_finite()) || coverage.windows(2).any(|w| w[1] > w[0]) {
-        return Err(Error::Internal(format!(
-            "glTF export: screen coverage {coverage:?} must be finite and non-increasing"
-        )));
-    }
-    let mut buffer = Buffer::default();
-    let mut materials = Materials::default();
+    space: Mat4,
+    buffer: &mut Buffer,
+    materials: &mut Materials,
+) -> Result<Vec<Value>> {
+    let normal_space = Mat3::from_mat4(space).inverse().transpose();
+    // Tangents are directions in the surface: moved by the linear part; a mirroring transform
+    // flips the bitangent's sign.
+    let space_vectors = Mat3::from_mat4(space);
+    let handedness = space_vectors.determinant().signum();
     let mut meshes = Vec::new();
     for (name, mesh) in levels {
-        let p: Vec<f32> = mesh.positions().iter().flat_map(|v| v.to_array()).collect();
-        let n: Vec<f32> = mesh.normals().iter().flat_map(|v| v.to_array()).collect();
+        let p: Vec<f32> = mesh
+            .positions()
+            .iter()
+            .flat_map(|v| space.transform_point3(*v).to_array())
+            .collect();
+        let n: Vec<f32> = mesh
+            .normals()
+            .iter()
+            .flat_map(|v| (normal_space * *v).normalize_or(*v).to_array())
+            .collect();
         let mut attributes = json!({
             "POSITION": buffer.floats(&p, 3, true),
             "NORMAL": buffer.floats(&n, 3, false),
         });
-        if let Some(uvs) = mesh.uvs() {
-            let t: Vec<f32> = uvs.iter().flat_map(|u| [u.x, 1.0 - u.y]).collect();
-            attributes["TEXCOORD_0"] = json!(buffer.floats(&t, 2, false));
+        for (set, uvs) in [(0, mesh.uvs()), (1, mesh.uvs1())] {
+            if let Some(uvs) = uvs {
+                let t: Vec<f32> = uvs.iter().flat_map(|u| [u.x, 1.0 - u.y]).collect();
+                attributes[format!("TEXCOORD_{set}")] = json!(buffer.floats(&t, 2, false));
+            }
         }
         if let Some(colors) = mesh.colors() {
             let c: Vec<f32> = colors.iter().flat_map(|c: &Vec3| c.to_array()).collect();
             attributes["COLOR_0"] = json!(buffer.floats(&c, 3, false));
+        }
+        // The tangents lodeval's normal mapping uses, so an engine draws what was measured.
+        let normal_mapped = mesh.materials().iter().any(|m| m.normal_texture.is_some());
+        if let (true, Some(uvs)) = (normal_mapped, mesh.uvs()) {
+            let t =
+                super::tangents::generate(mesh.positions(), mesh.normals(), uvs, mesh.triangles());
+            let t: Vec<f32> = t
+                .iter()
+                .flat_map(|t| {
+                    let d = (space_vectors * t.truncate()).normalize_or(t.truncate());
+                    [d.x, d.y, d.z, t.w * handedness]
+                })
+                .collect();
+            attributes["TANGENT"] = json!(buffer.floats(&t, 4, false));
         }
         let mut primitives = Vec::new();
         for (mi, m) in mesh.materials().iter().enumerate() {
@@ -253,45 +255,175 @@ pub fn write_lod_chain(
         }
         meshes.push(json!({ "name": name, "primitives": primitives }));
     }
+    Ok(meshes)
+}
+
+/// `KHR_lights_punctual` lights and the nodes that place them (world space: position as
+/// translation, the −Z axis turned onto the light's direction).
+fn light_nodes(mesh: &Mesh, first_node: usize) -> (Vec<Value>, Vec<Value>) {
+    let (mut lights, mut nodes) = (Vec::new(), Vec::new());
+    for (i, l) in mesh.lights().iter().enumerate() {
+        let mut light = json!({
+            "color": l.color.to_array(),
+            "intensity": l.intensity,
+        });
+        match l.kind {
+            LightKind::Directional => light["type"] = json!("directional"),
+            LightKind::Point => light["type"] = json!("point"),
+            LightKind::Spot {
+                inner_cone,
+                outer_cone,
+            } => {
+                light["type"] = json!("spot");
+                light["spot"] =
+                    json!({ "innerConeAngle": inner_cone, "outerConeAngle": outer_cone });
+            }
+        }
+        if let Some(r) = l.range {
+            light["range"] = json!(r);
+        }
+        if let Some(name) = &l.name {
+            light["name"] = json!(name);
+        }
+        let rotation = glam::Quat::from_rotation_arc(-Vec3::Z, l.direction.normalize_or(-Vec3::Z));
+        nodes.push(json!({
+            "name": l.name.clone().unwrap_or_else(|| format!("light {}", first_node + i)),
+            "translation": l.position.to_array(),
+            "rotation": rotation.to_array(),
+            "extensions": { "KHR_lights_punctual": { "light": i } },
+        }));
+        lights.push(light);
+    }
+    (lights, nodes)
+}
+
+/// Every file [`write_lod_chain`] writes for `levels` at `path`, without writing anything.
+pub fn planned_files(levels: &[(&str, &Mesh)], path: &Path) -> Result<Vec<PathBuf>> {
+    let mut materials = Materials::default();
+    for (_, mesh) in levels {
+        for m in mesh.materials() {
+            materials.material(m)?;
+        }
+    }
+    let mut files = vec![path.to_path_buf()];
+    if path.extension().and_then(|e| e.to_str()) == Some("gltf") {
+        let dir = crate::io::parent_dir(path);
+        let stem = stem_of(path);
+        files.push(dir.join(format!("{stem}.bin")));
+        files.extend(
+            image_files(&stem, &materials.images)
+                .into_iter()
+                .map(|f| dir.join(f)),
+        );
+    }
+    Ok(files)
+}
+
+fn stem_of(path: &Path) -> String {
+    path.file_stem()
+        .map_or_else(|| "lods".into(), |s| s.to_string_lossy().into_owned())
+}
+
+/// What the chain cannot carry of the finest level's source: nodes merged under different
+/// transforms.
+fn node_warnings(mesh: &Mesh, shared: &Option<(String, Mat4)>) -> Vec<String> {
+    let nodes = &mesh.source().nodes;
+    if nodes.len() > 1 && shared.is_none() {
+        let mut names: Vec<&str> = nodes.iter().take(4).map(|n| n.name.as_str()).collect();
+        if nodes.len() > 4 {
+            names.push("…");
+        }
+        return vec![format!(
+            "the input's {} mesh nodes ({}) are merged into one node per level, their transforms \
+             applied to the vertices",
+            nodes.len(),
+            names.join(", ")
+        )];
+    }
+    Vec::new()
+}
+
+/// Write `levels` (finest first, each with its name) as one glTF asset at `path` (`.glb` or
+/// `.gltf`), linked by `MSFT_lod`, with `coverage` (one value per level, non-increasing, the last
+/// usually 0) as `MSFT_screencoverage`. Returns every file written and what could not be kept.
+pub fn write_lod_chain(levels: &[(&str, &Mesh)], coverage: &[f64], path: &Path) -> Result<Written> {
+    let ext = path.extension().and_then(|e| e.to_str()).unwrap_or("");
+    if ext != "glb" && ext != "gltf" {
+        return Err(Error::Usage(format!(
+            "{}: a glTF LOD chain is written as .glb or .gltf",
+            path.display()
+        )));
+    }
+    if levels.is_empty() || coverage.len() != levels.len() {
+        return Err(Error::Internal(format!(
+            "glTF export: {} levels and {} coverage values",
+            levels.len(),
+            coverage.len()
+        )));
+    }
+    if coverage.iter().any(|c| !c.is_finite()) || coverage.windows(2).any(|w| w[1] > w[0]) {
+        return Err(Error::Internal(format!(
+            "glTF export: screen coverage {coverage:?} must be finite and non-increasing"
+        )));
+    }
+    // The finest level's node: its name and transform where every merged node shared one.
+    let finest = levels[0].1;
+    let shared = shared_transform(finest);
+    let space = shared.as_ref().map_or(Mat4::IDENTITY, |(_, m)| m.inverse());
+    let mut buffer = Buffer::default();
+    let mut materials = Materials::default();
+    let meshes = level_meshes(levels, space, &mut buffer, &mut materials)?;
     let mut nodes: Vec<Value> = levels
         .iter()
         .enumerate()
         .map(|(i, (name, _))| json!({ "name": name, "mesh": i }))
         .collect();
+    let mut extensions_used = std::mem::take(&mut materials.extensions_used);
     if levels.len() > 1 {
         nodes[0]["extensions"] =
             json!({ "MSFT_lod": { "ids": (1..levels.len()).collect::<Vec<_>>() } });
         nodes[0]["extras"] = json!({ "MSFT_screencoverage": coverage });
+        extensions_used.insert("MSFT_lod".into());
     }
-    let stem = path
-        .file_stem()
-        .map_or_else(|| "lods".into(), |s| s.to_string_lossy().into_owned());
+    // The scene: the finest level (under its node's transform), then the file's lights.
+    let mut roots = vec![0];
+    if let Some((name, world)) = &shared {
+        nodes.push(transform_node(name, world));
+        roots = vec![nodes.len() - 1];
+    }
+    let (lights, light_nodes) = light_nodes(finest, nodes.len());
+    for n in light_nodes {
+        nodes.push(n);
+        roots.push(nodes.len() - 1);
+    }
+    if !lights.is_empty() {
+        extensions_used.insert("KHR_lights_punctual".into());
+    }
+    let stem = stem_of(path);
     let mut written = vec![path.to_path_buf()];
-    let mut images = Vec::new();
     let dir = crate::io::parent_dir(path);
-    for (k, png) in materials.pngs.iter().enumerate() {
+    let names = image_files(&stem, &materials.images);
+    let mut images = Vec::new();
+    let mut files_out: Vec<(PathBuf, &[u8])> = Vec::new();
+    for (im, file) in materials.images.iter().zip(&names) {
         if ext == "glb" {
-            let view = buffer.view(png, None);
-            images.push(json!({ "bufferView": view, "mimeType": "image/png" }));
+            let view = buffer.view(&im.bytes, None);
+            images.push(json!({ "bufferView": view, "mimeType": im.mime, "name": im.name }));
         } else {
-            // Images as files beside the JSON.
-            let file = format!("{stem}-image{k}.png");
-            crate::io::write_atomic(&dir.join(&file), png)?;
-            written.push(dir.join(&file));
-            images.push(json!({ "uri": file, "mimeType": "image/png" }));
+            files_out.push((dir.join(file), &im.bytes));
+            images.push(json!({ "uri": file, "mimeType": im.mime, "name": im.name }));
         }
     }
     let mut buffer_json = json!({ "byteLength": buffer.bytes.len() });
     if ext == "gltf" {
         let bin = format!("{stem}.bin");
-        crate::io::write_atomic(&dir.join(&bin), &buffer.bytes)?;
-        written.push(dir.join(&bin));
+        files_out.push((dir.join(&bin), &buffer.bytes));
         buffer_json["uri"] = json!(bin);
     }
     let mut root = json!({
         "asset": { "version": "2.0", "generator": concat!("lodeval ", env!("CARGO_PKG_VERSION")) },
         "scene": 0,
-        "scenes": [{ "nodes": [0] }],
+        "scenes": [{ "nodes": roots }],
         "nodes": nodes,
         "meshes": meshes,
         "materials": materials.json,
@@ -303,11 +435,22 @@ pub fn write_lod_chain(
         root["images"] = json!(images);
         root["textures"] = json!(materials.texture_json);
     }
-    if levels.len() > 1 {
-        root["extensionsUsed"] = json!(["MSFT_lod"]);
+    if !materials.sampler_json.is_empty() {
+        root["samplers"] = json!(materials.sampler_json);
+    }
+    if !lights.is_empty() {
+        root["extensions"] = json!({ "KHR_lights_punctual": { "lights": lights } });
+    }
+    if !extensions_used.is_empty() {
+        root["extensionsUsed"] = json!(extensions_used);
     }
     let text = serde_json::to_vec(&root)
         .map_err(|e| Error::Internal(format!("glTF export: JSON: {e}")))?;
+    // Side files first, the document last: a failure leaves no document naming missing files.
+    for (file, bytes) in &files_out {
+        crate::io::write_atomic(file, bytes)?;
+        written.push(file.clone());
+    }
     if ext == "glb" {
         let glb = gltf::binary::Glb {
             header: gltf::binary::Header {
@@ -325,5 +468,10 @@ pub fn write_lod_chain(
     } else {
         crate::io::write_atomic(path, &text)?;
     }
-    Ok(written)
+    let mut warnings = node_warnings(finest, &shared);
+    warnings.append(&mut materials.warnings);
+    Ok(Written {
+        files: written,
+        warnings,
+    })
 }

@@ -41,7 +41,6 @@ mod scene;
 mod setup;
 pub(crate) mod shade;
 mod sort_last;
-mod tangents;
 mod texture;
 pub mod texture_space;
 

@@ -7,7 +7,6 @@ use std::sync::Arc;
 
 use glam::Vec4;
 
-use super::tangents;
 use super::texture::MipTexture;
 use crate::mesh::{Mesh, Texture};
 
@@ -32,8 +31,8 @@ impl PreparedMesh {
         // Key by the texture's address: equal Arcs are the same decoded image. Only looked up,
         // never iterated, so the map's order cannot reach an output.
         let mut built: HashMap<*const Texture, Arc<MipTexture>> = HashMap::new();
-        let mut pyramid = |t: &Option<Arc<Texture>>| {
-            t.as_ref().map(|t| {
+        let mut pyramid = |t: &Option<crate::mesh::TextureSlot>| {
+            t.as_ref().map(|s| &s.texture).map(|t| {
                 built
                     .entry(Arc::as_ptr(t))
                     .or_insert_with(|| Arc::new(MipTexture::build(t)))
@@ -50,7 +49,7 @@ impl PreparedMesh {
             .collect();
         let has_normal_maps = mesh.materials().iter().any(|m| m.normal_texture.is_some());
         let tangents = match (mesh.uvs(), has_normal_maps) {
-            (Some(uvs), true) => Some(tangents::generate(
+            (Some(uvs), true) => Some(crate::mesh::tangents::generate(
                 mesh.positions(),
                 mesh.normals(),
                 uvs,

@@ -238,10 +238,12 @@ fn flat_layout(mesh: &Mesh, centre: Vec2) -> Result<Mesh> {
         positions: uvs.iter().map(|&u| (u - centre).extend(0.0)).collect(),
         normals: Some(vec![Vec3::Z; uvs.len()]),
         uvs: None,
+        uvs1: None,
         colors: None,
         triangles: mesh.triangles().to_vec(),
         material_ids: Vec::new(),
         materials: Vec::new(),
+        lights: Vec::new(),
         source: Source {
             edited: true,
             ..mesh.source().clone()

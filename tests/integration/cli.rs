@@ -80,7 +80,8 @@ fn glb_with_normal_map_reports_both_textures() {
         })
         .collect();
     assert!(
-        roles.contains(&"base_color".to_string()) && roles.contains(&"normal".to_string()),
+        roles.contains(&"baseColorTexture".to_string())
+            && roles.contains(&"normalTexture".to_string()),
         "{roles:?}"
     );
 }

@@ -12,6 +12,8 @@
 //! - `fuzz`: property-based mutation fuzzing of the OBJ, PLY, OFF and GLB paths.
 //! - `hostile`: hostile input by class (`hostile/mod.rs` lists them): refused with exit 2, never
 //!   an abort, a hang or a silently wrong pass.
+//! - `materials`: glTF materials loaded whole (every slot, sampler, UV set, transform, extension)
+//!   and exported whole by `simplify -o X.glb|.gltf`; MTL PBR keys; what cannot be carried is named.
 //! - `menzel_guthe`: `lodeval simplify --method menzel-guthe` (Menzel & Guthe 2010): goals and
 //!   distances, thread independence, the eval generator, bad requests.
 //! - `optimize`: `lodeval optimize` (Lindstrom–Turk): energy goes down, the vertex count stays,
@@ -36,6 +38,7 @@ mod fuzz;
 #[cfg(feature = "gpu")]
 mod gpu;
 mod hostile;
+mod materials;
 mod menzel_guthe;
 mod models;
 mod optimize;

@@ -18,6 +18,13 @@ const MANIFEST: &[(&str, usize, usize, usize)] = &[
     ("gltf/Avocado/Avocado.gltf", 406, 682, 682),
     ("gltf/Barrel/barrel.glb", 856, 1148, 1148),
     ("gltf/BoxTextured/BoxTextured.gltf", 24, 12, 12),
+    (
+        "pbr/MetalRoughSpheresNoTextures/glTF/MetalRoughSpheresNoTextures.gltf",
+        528291,
+        1040409,
+        1040409,
+    ),
+    ("pbr/Suzanne/glTF/Suzanne.gltf", 11808, 3936, 3936),
     ("scans/bunny/stanford-bunny.obj", 35947, 69451, 69451),
     ("scans/bunny/bunny_odedstein_3k.obj", 3301, 6598, 6598),
     (
@@ -116,11 +123,12 @@ fn textured_models_bind_their_textures() {
         .filter(|m| !m["textures"].as_array().unwrap().is_empty())
         .count();
     assert_eq!(textured, 5);
-    // DamagedHelmet: base colour and normal map decoded, the other three maps not needed.
+    // DamagedHelmet: every slot decoded (base colour, metallic–roughness, normal, occlusion,
+    // emissive).
     let helmet = info_json(&root.join("gltf/DamagedHelmet/DamagedHelmet.gltf"));
     assert_eq!(
         helmet["materials"][0]["textures"].as_array().unwrap().len(),
-        2
+        5
     );
 }
 

@@ -54,7 +54,7 @@ fn a_remesh_has_its_vertices_maps_and_json() {
         info.stdout
     );
     assert!(
-        info.stdout.contains("uvs: yes") && info.stdout.contains("base_color"),
+        info.stdout.contains("uvs: yes") && info.stdout.contains("baseColorTexture"),
         "{}",
         info.stdout
     );

@@ -159,10 +159,12 @@ fn quad_mesh() -> Mesh {
         positions: vec![p(-2.5, -2.5), p(2.5, -2.5), p(2.5, 2.5), p(-2.5, 2.5)],
         normals: None,
         uvs: None,
+        uvs1: None,
         colors: None,
         triangles: vec![[0, 1, 2], [0, 2, 3]],
         material_ids: vec![],
         materials: vec![],
+        lights: Vec::new(),
         source: Source {
             path: "<quad>".into(),
             format: Format::Obj,
@@ -171,6 +173,7 @@ fn quad_mesh() -> Mesh {
             file_unreferenced: 0,
             edited: false,
             files: Vec::new(),
+            nodes: Vec::new(),
         },
         warnings: vec![],
     };

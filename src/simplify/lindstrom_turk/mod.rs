@@ -110,6 +110,8 @@ pub struct Accepted {
 pub struct Outcome {
     /// The optimized mesh.
     pub mesh: Mesh,
+    /// What writing it could not keep of the input (filled in by the command that writes it).
+    pub warnings: Vec<String>,
     /// d_MS of the input over the optimization views.
     pub initial_d_ms: f64,
     /// d_MS of the result over the optimization views.
@@ -451,6 +453,7 @@ fn run(
     let vertices_out = live_vertices(&opt.st.adj);
     let mesh = opt.st.adj.to_mesh(simplified)?;
     Ok(Outcome {
+        warnings: Vec::new(),
         mesh,
         initial_d_ms,
         final_d_ms: d_ms(&opt),

@@ -340,10 +340,12 @@ impl Built {
             positions: self.positions,
             normals: Some(self.normals),
             uvs: Some(self.uvs),
+            uvs1: None,
             colors: self.colors,
             triangles: self.triangles,
             material_ids: self.material_ids,
             materials: mesh.materials().to_vec(),
+            lights: Vec::new(),
             source: crate::mesh::Source {
                 edited: true,
                 ..mesh.source().clone()

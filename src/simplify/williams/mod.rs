@@ -474,7 +474,7 @@ mod tests {
         )
         .unwrap();
         let mut mat = crate::mesh::Material::default_material();
-        mat.base_color_texture = Some(std::sync::Arc::new(tex));
+        mat.base_color_texture = Some(crate::mesh::TextureSlot::plain(std::sync::Arc::new(tex)));
         data.materials = vec![mat];
         data.material_ids = Vec::new();
         let plane = Mesh::new(data, &LoadOptions::default()).unwrap();

@@ -194,11 +194,14 @@ pub fn preprocess(h: &Hierarchy) -> Preprocessed {
         .map(|m| MaterialFacts {
             specular: luminance(m.specular),
             shininess: m.shininess,
-            tilt: m.normal_texture.as_deref().map_or(0.0, normal_map_tilt),
+            tilt: m
+                .normal_texture
+                .as_ref()
+                .map_or(0.0, |s| normal_map_tilt(&s.texture)),
             pyramid: m
                 .base_color_texture
-                .as_deref()
-                .map(|t| LuminancePyramid::new(t, m.base_color)),
+                .as_ref()
+                .map(|s| LuminancePyramid::new(&s.texture, m.base_color)),
             base: luminance(m.base_color),
         })
         .collect();

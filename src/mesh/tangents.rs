@@ -9,7 +9,7 @@
 use glam::{Vec2, Vec3, Vec4};
 
 /// Tangents (xyz, unit, ⟂ normal) with handedness in w (±1), one per vertex.
-pub(crate) fn generate(
+pub fn generate(
     positions: &[Vec3],
     normals: &[Vec3],
     uvs: &[Vec2],
