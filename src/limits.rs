@@ -236,6 +236,32 @@ pub const EXPOSURES: Bound<u64> = Bound {
     why: "64 exposures span far more than any display's range; each costs a whole FLIP",
 };
 
+/// Width of an environment map (`environment = PATH`), texels; the height is half. The renderer
+/// prefilters at most 512 texels across, so a larger map only costs memory: 8 192 × 4 096 takes
+/// 400 MiB as floats.
+pub const ENVIRONMENT_SIDE: Bound<u64> = Bound {
+    min: 16,
+    max: 8192,
+    unit: "texels across",
+    why: "an 8 192-wide map already takes 400 MiB, and the lighting is prefiltered at 512",
+};
+
+/// Exposure in stops (`exposure`, `--exposure`): 2^±24 spans far more than any scene's range.
+pub const EXPOSURE_STOPS: Bound<f64> = Bound {
+    min: -24.0,
+    max: 24.0,
+    unit: "stops",
+    why: "2^24 is beyond any scene's range, and single precision loses it",
+};
+
+/// Environment intensity (`environment_intensity`): a factor on the map's radiance.
+pub const ENVIRONMENT_INTENSITY: Bound<f64> = Bound {
+    min: 0.0,
+    max: 1e6,
+    unit: "",
+    why: "a million times a map's radiance is beyond any exposure",
+};
+
 /// A mesh's size: its bounding-box diagonal in model units. Squared triangle areas (fourth
 /// powers of lengths) are formed in single precision, whose range is about 1e±38.
 pub const MESH_EXTENT: Bound<f64> = Bound {

@@ -48,6 +48,8 @@ pub struct RenderJob {
     pub exr: bool,
     /// Where to render.
     pub backend: crate::backend::Backend,
+    /// The `pbr` model's image-based lighting.
+    pub lighting: crate::scene::Lighting,
 }
 
 pub(crate) fn write_frame(path: &Path, frame: &Frame, exr: bool) -> Result<()> {
@@ -80,7 +82,8 @@ pub fn render(job: &RenderJob) -> Result<RenderReport> {
     )
     .map_err(Error::Usage)?;
     let mesh = Arc::new(mesh::load(&job.mesh, &job.load)?);
-    let scene = RenderScene::of(mesh.clone());
+    let mut scene = RenderScene::of(mesh.clone());
+    scene.light_with(&job.lighting);
     let aspect = job.settings.width as f32 / job.settings.height as f32;
     let cameras = job.rig.cameras(&mesh, aspect);
     let engine = crate::backend::Engine::new(job.backend)?;

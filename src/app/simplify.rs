@@ -22,6 +22,8 @@ pub struct SimplifyJob {
     pub chain: bool,
     /// Metres per model unit (menzel-guthe's distance goals).
     pub meters_per_unit: f64,
+    /// How a glTF chain's switch points are measured (shading, lighting, display).
+    pub look: crate::eval::config::Look,
 }
 
 /// One written LOD.
@@ -168,7 +170,7 @@ pub fn simplify(
             .collect();
         let refs: Vec<(&str, std::sync::Arc<Mesh>)> =
             named.iter().map(|(n, m)| (n.as_str(), m.clone())).collect();
-        let rows = crate::eval::export::measure(&original, &refs, job.meters_per_unit)?;
+        let rows = crate::eval::export::measure(&original, &refs, job.meters_per_unit, &job.look)?;
         let chain: Vec<(&str, &Mesh)> = named.iter().map(|(n, m)| (n.as_str(), &**m)).collect();
         let (_, notes) = crate::eval::export::write_chain(
             &job.out,

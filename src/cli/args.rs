@@ -4,8 +4,8 @@
 
 use clap::{Args, ValueEnum};
 use lodeval::limits::Bound;
-use lodeval::raster::{SamplePattern, Shading};
-use lodeval::scene::Rig;
+use lodeval::raster::{RenderSettings, SamplePattern, Shading, ToneMapping};
+use lodeval::scene::{Lighting, Rig};
 use lodeval::{Error, LoadOptions, MissingAssets};
 
 #[derive(Copy, Clone, Debug, ValueEnum)]
@@ -147,5 +147,74 @@ pub(crate) fn value(
             .parse()
             .map_err(|_| format!("'{text}' is not a number of {}", bound.unit))?;
         bound.refuse(v).map_or(Ok(v), Err)
+    }
+}
+
+/// `--tone-mapping`: one of the display transform's tone mappers.
+pub(crate) fn parse_tone_mapping(text: &str) -> Result<ToneMapping, String> {
+    ToneMapping::parse(text).ok_or_else(|| {
+        let names: Vec<&str> = ToneMapping::ALL.iter().map(|t| t.name()).collect();
+        format!(
+            "unknown tone mapper '{text}': use one of {}",
+            names.join(", ")
+        )
+    })
+}
+
+/// How the `pbr` model is lit and every model is shown: the flags `render`, `compare` and
+/// `simplify -o CHAIN.glb` share with a config's `[render]` section.
+#[derive(Args, Debug, Clone)]
+pub(crate) struct LookArgs {
+    /// Image-based lighting of the pbr model: `neutral` (a built-in lit room) or an
+    /// equirectangular (2:1) Radiance .hdr or OpenEXR .exr file.
+    #[arg(long, default_value = "neutral", value_name = "neutral|PATH")]
+    pub(crate) environment: String,
+    /// Rotation of the environment about the up axis, degrees.
+    #[arg(long, default_value_t = 0.0, value_parser = finite, value_name = "DEGREES")]
+    pub(crate) environment_rotation: f64,
+    /// Factor on the environment's radiance.
+    #[arg(long, default_value_t = 1.0, value_parser = value(&lodeval::limits::ENVIRONMENT_INTENSITY))]
+    pub(crate) environment_intensity: f64,
+    /// Exposure in stops (radiance × 2^STOPS before tone mapping).
+    #[arg(long, default_value_t = 0.0, value_parser = value(&lodeval::limits::EXPOSURE_STOPS), value_name = "STOPS")]
+    pub(crate) exposure: f64,
+    /// Tone mapper: linear (a clamp), aces (Hill's fit) or pbr-neutral (Khronos). Default:
+    /// pbr-neutral for the pbr model, linear for the others.
+    #[arg(long, value_parser = parse_tone_mapping)]
+    pub(crate) tone_mapping: Option<ToneMapping>,
+    /// Turn off the pbr model's multiple-scattering energy compensation.
+    #[arg(long)]
+    pub(crate) no_multiple_scattering: bool,
+}
+
+impl LookArgs {
+    /// The lighting these flags choose (the environment file is read here).
+    pub(crate) fn lighting(&self) -> Result<Lighting, Error> {
+        Lighting::new(
+            &self.environment,
+            std::path::Path::new("."),
+            self.environment_rotation as f32,
+            self.environment_intensity as f32,
+        )
+    }
+
+    /// The look of a one-off run (`compare`, `simplify -o CHAIN.glb`) with `shading`.
+    pub(crate) fn look(&self, shading: Shading) -> lodeval::eval::config::Look {
+        lodeval::eval::config::Look {
+            shading,
+            environment: self.environment.clone(),
+            environment_rotation: self.environment_rotation,
+            environment_intensity: self.environment_intensity,
+            exposure: self.exposure,
+            tone_mapping: self.tone_mapping,
+            multiple_scattering: !self.no_multiple_scattering,
+        }
+    }
+
+    /// Set the display transform and the pbr options on `settings`.
+    pub(crate) fn apply(&self, settings: &mut RenderSettings) {
+        settings.exposure = self.exposure as f32;
+        settings.tone_mapping = self.tone_mapping;
+        settings.multiple_scattering = !self.no_multiple_scattering;
     }
 }

@@ -7,7 +7,7 @@ use clap::Args;
 use lodeval::Error;
 use lodeval::eval::compare::{CompareJob, CompareReport};
 
-use super::args::{BackendArg, count};
+use super::args::{BackendArg, LookArgs, count, parse_shading};
 use super::print::{emit, emit_json, warnings};
 use super::progress::Reporter;
 
@@ -36,6 +36,12 @@ pub(crate) struct CompareArgs {
     /// Print JSON: every view's scores, the summary and the distances.
     #[arg(long)]
     pub(crate) json: bool,
+    /// Shading model: auto (pbr for metallic–roughness materials, gouraud otherwise), pbr,
+    /// gouraud, phong, normal-mapped, unlit.
+    #[arg(long, default_value = "auto", value_parser = parse_shading)]
+    pub(crate) shading: lodeval::raster::Shading,
+    #[command(flatten)]
+    pub(crate) look: LookArgs,
 }
 
 /// Run `compare`.
@@ -47,6 +53,7 @@ pub(crate) fn run(a: CompareArgs, quiet: bool) -> Result<(), Error> {
         size: a.size,
         distances: !a.no_distances,
         backend: a.backend.into(),
+        look: a.look.look(a.shading),
     };
     let report = lodeval::eval::compare::compare(&job, &Reporter::new(quiet || a.json))?;
     warnings(&report.warnings);

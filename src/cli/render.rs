@@ -10,7 +10,8 @@ use lodeval::raster::{RenderSettings, Shading};
 use lodeval::scene::Rig;
 
 use super::args::{
-    BackendArg, LoadArgs, PatternArg, count, parse_rig, parse_samples, parse_shading, side,
+    BackendArg, LoadArgs, LookArgs, PatternArg, count, parse_rig, parse_samples, parse_shading,
+    side,
 };
 use super::print::warnings;
 
@@ -42,8 +43,9 @@ pub(crate) struct RenderArgs {
     /// Write every view as one contact sheet (a grid) to --out.
     #[arg(long)]
     pub(crate) sheet: bool,
-    /// Shading model: unlit, gouraud, phong, normal-mapped, normals, depth.
-    #[arg(long, default_value = "gouraud", value_parser = parse_shading)]
+    /// Shading model: auto (pbr for metallic–roughness materials, gouraud otherwise), pbr,
+    /// unlit, gouraud, phong, normal-mapped, normals, depth.
+    #[arg(long, default_value = "auto", value_parser = parse_shading)]
     pub(crate) shading: Shading,
     /// Samples per pixel (a square: 1, 4, 9, ..., 64).
     #[arg(long, default_value = "4", value_parser = parse_samples)]
@@ -63,6 +65,8 @@ pub(crate) struct RenderArgs {
     pub(crate) backend: BackendArg,
     #[command(flatten)]
     pub(crate) load: LoadArgs,
+    #[command(flatten)]
+    pub(crate) look: LookArgs,
 }
 
 impl RenderArgs {
@@ -73,6 +77,8 @@ impl RenderArgs {
         settings.shading = self.shading;
         settings.cull_backfaces = self.cull_backfaces;
         settings.samples = self.pattern.with_side(side(self.samples));
+        self.look.apply(&mut settings);
+        let lighting = self.look.lighting()?;
         let views = match (self.all_views, self.sheet, self.out, self.out_dir) {
             (true, _, _, Some(out_dir)) => ViewSelection::All { out_dir },
             (_, true, Some(out), _) => ViewSelection::Sheet { out },
@@ -94,6 +100,7 @@ impl RenderArgs {
             views,
             exr: self.exr,
             backend: self.backend.into(),
+            lighting,
         })
     }
 }

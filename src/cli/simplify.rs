@@ -10,7 +10,7 @@ use lodeval::scene::Rig;
 use lodeval::simplify::Method;
 use lodeval::simplify::williams::Criterion;
 
-use super::args::{count, parse_rig, parse_shading};
+use super::args::{LookArgs, count, parse_rig, parse_shading};
 use super::print::{emit, emit_json};
 use super::progress::Reporter;
 
@@ -118,9 +118,13 @@ pub(crate) struct SimplifyArgs {
     /// williams: view rig for --view and --all-views.
     #[arg(long, default_value = "dodecahedron", value_parser = parse_rig)]
     pub(crate) rig: Rig,
-    /// williams: the shading the LOD is for (gouraud, phong, normal-mapped, unlit).
-    #[arg(long, default_value = "gouraud", value_parser = parse_shading)]
+    /// The shading a `.glb`/`.gltf` chain's switch points are measured with (auto: pbr for
+    /// metallic–roughness materials, gouraud otherwise), and for williams the shading the LOD is
+    /// for (gouraud, phong, normal-mapped, unlit; auto means gouraud).
+    #[arg(long, default_value = "auto", value_parser = parse_shading)]
     pub(crate) shading: Shading,
+    #[command(flatten)]
+    pub(crate) look: LookArgs,
     /// williams: perceptual, object-space, screen-space or silhouette-10.
     #[arg(long, value_enum, default_value_t = CriterionArg::Perceptual)]
     pub(crate) criterion: CriterionArg,
@@ -227,6 +231,7 @@ pub(crate) fn run(a: SimplifyArgs, quiet: bool) -> Result<(), Error> {
         chain: !a.chain.is_empty(),
         goals: goals.clone(),
         meters_per_unit: a.meters_per_unit,
+        look: a.look.look(a.shading),
     };
     let report = lodeval::app::simplify(&job, &Reporter::new(quiet))?;
     super::print::warnings(&report.warnings);
@@ -338,7 +343,17 @@ pub(crate) fn williams_job(a: &SimplifyArgs) -> Result<lodeval::app::WilliamsJob
         out: a.out.clone().expect("clap requires it"),
         goal,
         views,
-        shading: a.shading,
+        shading: match a.shading {
+            Shading::Auto => Shading::Gouraud,
+            Shading::Pbr => {
+                return Err(Error::Usage(
+                    "--method williams models Blinn–Phong shading (gouraud, phong, \
+                     normal-mapped, unlit); pbr is not one of them"
+                        .into(),
+                ));
+            }
+            s => s,
+        },
         criterion: a.criterion.criterion(),
         size: a.size,
     })

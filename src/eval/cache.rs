@@ -74,7 +74,18 @@ impl RenderCache {
             h.update(&bytes);
         }
         let s = scene.scene();
-        h.update(format!("{:?}|{:?}|{:?}", s.lights, s.background, s.ambient).as_bytes());
+        h.update(
+            format!(
+                "{:?}|{:?}|{:?}|{}|{}|{}",
+                s.lights,
+                s.background,
+                s.ambient,
+                s.environment.key(),
+                s.environment_rotation_deg,
+                s.environment_intensity
+            )
+            .as_bytes(),
+        );
         Ok(SceneKey(h.finalize().to_vec()))
     }
 

@@ -28,6 +28,8 @@ pub struct CompareJob {
     pub distances: bool,
     /// Where frames are rendered.
     pub backend: crate::backend::Backend,
+    /// Shading, lighting and display.
+    pub look: super::config::Look,
 }
 
 /// What `compare` found.
@@ -87,6 +89,7 @@ fn plan(job: &CompareJob) -> Result<Plan> {
     let mut render = toml::Table::new();
     render.insert("size".into(), i64::from(job.size).into());
     render.insert("rig".into(), rig_for(job.views).into());
+    job.look.insert_into(&mut render);
     let mut images = toml::Table::new();
     images.insert("heatmaps".into(), "none".into());
     images.insert("contact_sheets".into(), false.into());

@@ -17,8 +17,8 @@ use serde::Deserialize;
 
 use crate::error::{Error, Location, Result};
 use crate::metric::vdp::Display;
-use crate::raster::{RenderSettings, SamplePattern, Shading};
-use crate::scene::{Light, Rig, Viewing};
+use crate::raster::{RenderSettings, SamplePattern, Shading, ToneMapping};
+use crate::scene::{Light, Lighting, Rig, Viewing};
 
 /// A whole config file.
 #[derive(Debug, Clone, Deserialize)]
@@ -94,7 +94,8 @@ pub struct RenderConfig {
     pub pattern: PatternName,
     /// `dodecahedron`, `icosahedron` or `fibonacci:N`. Default value: `dodecahedron` (20 views).
     pub rig: RigName,
-    /// Shading model name. Default value: `gouraud`.
+    /// Shading model name. Default value: `auto` (`pbr` for metallic–roughness materials,
+    /// `gouraud` otherwise).
     pub shading: ShadingName,
     /// Skip back faces. Default value: false (flipped LOD triangles must show).
     pub cull_backfaces: bool,
@@ -102,8 +103,26 @@ pub struct RenderConfig {
     pub background: [UnitInterval; 3],
     /// Ambient term. Default value: 0.15.
     pub ambient: UnitInterval,
-    /// Lights. Default value: one headlight.
-    pub lights: Vec<LightConfig>,
+    /// Lights. Default value: one headlight for the Blinn–Phong models; the file's own
+    /// (`KHR_lights_punctual`) for `pbr`.
+    pub lights: Option<Vec<LightConfig>>,
+    /// Image-based lighting of `pbr`: `neutral` (built in) or an equirectangular `.hdr`/`.exr`
+    /// file, relative to the config. Default value: `neutral`.
+    pub environment: String,
+    /// Rotation of the environment about +Y, degrees. Default value: 0.
+    pub environment_rotation: Finite,
+    /// Factor on the environment's radiance (0 to 10⁶). Default value: 1.
+    pub environment_intensity: Intensity,
+    /// Exposure in stops (−24 to 24). Default value: 0.
+    pub exposure: Stops,
+    /// `linear`, `aces` or `pbr-neutral`. Default value: `pbr-neutral` for `pbr`, `linear`
+    /// for the others.
+    pub tone_mapping: Option<ToneMappingName>,
+    /// `pbr`'s multiple-scattering energy compensation. Default value: true.
+    pub multiple_scattering: bool,
+    /// The environment, read once when the config is loaded (not a key).
+    #[serde(skip)]
+    pub lighting: Lighting,
 }
 
 impl Default for RenderConfig {
@@ -113,11 +132,18 @@ impl Default for RenderConfig {
             samples: SampleCount(4),
             pattern: PatternName::Rotated,
             rig: RigName(Rig::Dodecahedron),
-            shading: ShadingName(Shading::Gouraud),
+            shading: ShadingName(Shading::Auto),
             cull_backfaces: false,
             background: [UnitInterval(0.5); 3],
             ambient: UnitInterval(0.15),
-            lights: vec![LightConfig::Headlight { intensity: None }],
+            lights: None,
+            environment: "neutral".into(),
+            environment_rotation: Finite(0.0),
+            environment_intensity: Intensity(1.0),
+            exposure: Stops(0.0),
+            tone_mapping: None,
+            multiple_scattering: true,
+            lighting: Lighting::default(),
         }
     }
 }
@@ -135,12 +161,114 @@ impl RenderConfig {
         };
         s.shading = self.shading.0;
         s.cull_backfaces = self.cull_backfaces;
+        s.exposure = self.exposure.0 as f32;
+        s.tone_mapping = self.tone_mapping.map(|t| t.0);
+        s.multiple_scattering = self.multiple_scattering;
         s
     }
 
-    /// The scene lights.
-    pub fn scene_lights(&self) -> Vec<Light> {
-        self.lights.iter().map(LightConfig::light).collect()
+    /// Read the environment the section names (relative to the config's folder); a bad file is
+    /// an input error naming it, with the config line that named it in the fix.
+    fn load_lighting(&self, text: &str, path: &Path) -> Result<Lighting> {
+        let base = path.parent().unwrap_or(Path::new("."));
+        Lighting::new(
+            &self.environment,
+            base,
+            self.environment_rotation.0 as f32,
+            self.environment_intensity.0 as f32,
+        )
+        .map_err(|e| match e {
+            Error::Input {
+                path: file,
+                location,
+                problem,
+                fix,
+            } => {
+                let line = text
+                    .find("environment =")
+                    .map_or(0, |i| text[..i].matches('\n').count() + 1);
+                Error::Input {
+                    path: file,
+                    location,
+                    problem,
+                    fix: format!("{fix} (named by {} line {line})", path.display()),
+                }
+            }
+            other => other,
+        })
+    }
+
+    /// The scene lights: the configured ones, or `None` for the default of the model that
+    /// draws the scene ([`Scene::default_lights`]).
+    pub fn scene_lights(&self) -> Option<Vec<Light>> {
+        self.lights
+            .as_ref()
+            .map(|lights| lights.iter().map(LightConfig::light).collect())
+    }
+}
+
+/// How a one-off run (`compare`, `simplify -o CHAIN.glb`) looks: the `[render]` keys the
+/// command line sets, written into the in-memory config the run builds.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Look {
+    /// Shading model. Default value: `auto`.
+    pub shading: Shading,
+    /// `neutral` or an environment file (absolute, or relative to the working directory).
+    pub environment: String,
+    /// Environment rotation, degrees.
+    pub environment_rotation: f64,
+    /// Environment intensity.
+    pub environment_intensity: f64,
+    /// Exposure, stops.
+    pub exposure: f64,
+    /// Tone mapper (`None`: the model's).
+    pub tone_mapping: Option<ToneMapping>,
+    /// `pbr`'s multiple-scattering term.
+    pub multiple_scattering: bool,
+}
+
+impl Default for Look {
+    fn default() -> Self {
+        Look {
+            shading: Shading::Auto,
+            environment: "neutral".into(),
+            environment_rotation: 0.0,
+            environment_intensity: 1.0,
+            exposure: 0.0,
+            tone_mapping: None,
+            multiple_scattering: true,
+        }
+    }
+}
+
+impl Look {
+    /// Set these keys in a `[render]` table (an environment file as an absolute path).
+    pub fn insert_into(&self, render: &mut toml::Table) {
+        render.insert("shading".into(), self.shading.name().into());
+        let environment = match self.environment.as_str() {
+            "neutral" => "neutral".to_string(),
+            path => std::path::absolute(path)
+                .unwrap_or_else(|_| PathBuf::from(path))
+                .to_string_lossy()
+                .into_owned(),
+        };
+        render.insert("environment".into(), environment.into());
+        render.insert(
+            "environment_rotation".into(),
+            self.environment_rotation.into(),
+        );
+        render.insert(
+            "environment_intensity".into(),
+            self.environment_intensity.into(),
+        );
+        render.insert("exposure".into(), self.exposure.into());
+        if let Some(t) = self.tone_mapping {
+            render.insert("tone_mapping".into(), t.name().into());
+        }
+        render.insert(
+            "multiple_scattering".into(),
+            self.multiple_scattering.into(),
+        );
     }
 }
 
@@ -518,6 +646,19 @@ checked_newtype!(
     Positive(f64), "f64", |v| v.is_finite() && v > 0.0, "use a finite number above 0"
 );
 checked_newtype!(
+    /// Any finite number.
+    Finite(f64), "f64", |v| v.is_finite(), "use a finite number"
+);
+checked_newtype!(
+    /// Exposure in stops ([`crate::limits::EXPOSURE_STOPS`]).
+    Stops(f64), "f64", |v| crate::limits::EXPOSURE_STOPS.contains(v), "use −24 to 24 stops"
+);
+checked_newtype!(
+    /// An environment intensity ([`crate::limits::ENVIRONMENT_INTENSITY`]).
+    Intensity(f64), "f64", |v| crate::limits::ENVIRONMENT_INTENSITY.contains(v),
+    "use 0 to 1000000"
+);
+checked_newtype!(
     /// A finite number ≥ 0.
     NonNegative(f64), "f64", |v| v.is_finite() && v >= 0.0, "use a finite number of at least 0"
 );
@@ -574,6 +715,20 @@ impl TryFrom<String> for ShadingName {
     }
 }
 
+/// A tone mapper by name.
+#[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
+#[serde(try_from = "String")]
+pub struct ToneMappingName(pub ToneMapping);
+impl TryFrom<String> for ToneMappingName {
+    type Error = String;
+    fn try_from(s: String) -> std::result::Result<Self, String> {
+        ToneMapping::parse(&s).map(ToneMappingName).ok_or_else(|| {
+            let names: Vec<_> = ToneMapping::ALL.iter().map(|t| t.name()).collect();
+            format!("unknown tone mapper '{s}': use one of {}", names.join(", "))
+        })
+    }
+}
+
 /// An asset or LOD name: safe as a folder name and a CSV field.
 #[derive(Debug, Clone, PartialEq, Eq, PartialOrd, Ord, Deserialize)]
 #[serde(try_from = "String")]
@@ -622,6 +777,8 @@ impl Config {
             }
         })?;
         config.check(text, path)?;
+        let mut config = config;
+        config.render.lighting = config.render.load_lighting(text, path)?;
         Ok(config)
     }
 

@@ -89,15 +89,30 @@ pub fn write_chain(
 }
 
 /// The imperceptibility distances of `lods` against `original` with `eval`'s defaults (the
-/// default display and viewer, the headlight, the FLIP and VDP criteria, the first three views of
-/// the dodecahedron rig), for a chain made outside `eval` (`lodeval simplify -o CHAIN.glb`).
+/// default display and viewer, the FLIP and VDP criteria, the first three views of the
+/// dodecahedron rig) and `look` (shading, lighting, display), for a chain made outside `eval`
+/// (`lodeval simplify -o CHAIN.glb`).
 pub fn measure(
     original: &Arc<Mesh>,
     lods: &[(&str, Arc<Mesh>)],
     meters_per_unit: f64,
+    look: &super::config::Look,
 ) -> Result<Vec<DistanceRow>> {
-    let cfg: super::config::Config = toml::from_str("asset = []")
+    let mut render = toml::Table::new();
+    look.insert_into(&mut render);
+    let mut table = toml::Table::new();
+    table.insert("render".into(), render.into());
+    table.insert("asset".into(), toml::Value::Array(Vec::new()));
+    let text = toml::to_string(&table)
         .map_err(|e| crate::error::Error::Internal(format!("default config: {e}")))?;
+    let mut cfg: super::config::Config = toml::from_str(&text)
+        .map_err(|e| crate::error::Error::Internal(format!("default config: {e}")))?;
+    cfg.render.lighting = crate::scene::Lighting::new(
+        &cfg.render.environment,
+        std::path::Path::new("."),
+        cfg.render.environment_rotation.0 as f32,
+        cfg.render.environment_intensity.0 as f32,
+    )?;
     let reference = super::run::scene_for(&cfg, original.clone());
     let cameras = cfg.render.rig.0.cameras(original, 1.0);
     let directions: Vec<glam::Vec3> = cameras.iter().take(3).map(|c| c.to_eye()).collect();

@@ -390,10 +390,11 @@ pub fn evaluate(
     Ok((results, warnings))
 }
 
-/// A scene of `mesh` with the config's lights, background and ambient term.
+/// A scene of `mesh` with the config's lights, environment, background and ambient term.
 pub fn scene_for(cfg: &super::config::Config, mesh: Arc<Mesh>) -> RenderScene {
     let mut s = Scene::new(mesh);
     s.lights = cfg.render.scene_lights();
+    s.light_with(&cfg.render.lighting);
     s.background = glam::Vec3::from_array(cfg.render.background.map(|c| c.0 as f32))
         .map(crate::color::srgb_to_linear);
     s.ambient = cfg.render.ambient.0 as f32;

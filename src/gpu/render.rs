@@ -1,10 +1,13 @@
 //! The GPU renderer: a [`RenderScene`] uploaded once, rendered from any camera into a [`Frame`].
 //!
-//! Upload (once per scene): one storage buffer of 16 floats per vertex (position, the vertex's
-//! material for Gouraud, normal, tangent handedness, UV, colour, tangent — absent attributes are
-//! zero/white), one of (i0, i1, i2, material) per triangle in source order, the materials, and the
-//! CPU's mip pyramids (`raster::MipTexture`, each texture once) flattened with a level table into
-//! up to four pages, each within one storage binding's size limit.
+//! Upload (once per scene): one storage buffer of 18 floats per vertex (position, the vertex's
+//! material for Gouraud, normal, tangent handedness, UV, colour, tangent, second UV — absent
+//! attributes are zero/white), one of (i0, i1, i2, material) per triangle in source order, the
+//! materials (every slot with its sampler, transform and UV set), and the CPU's mip pyramids
+//! (`raster::MipTexture`, each texture once) flattened with a level table into up to eight pages,
+//! each within one storage binding's size limit. The `pbr` model's image-based light (the CPU's
+//! prefiltered chain, irradiance map and BRDF table, `raster::ibl`) is placed after the textures
+//! as further levels, so the GPU shades from exactly the CPU's data.
 //!
 //! Per frame: stage 1, one draw of 3·T vertices per anti-aliasing sample into that sample's layer
 //! of an id and a depth array target (visibility.wgsl); stage 2, one compute dispatch that groups
@@ -26,14 +29,17 @@ use glam::{Vec3, Vec4};
 use super::Gpu;
 use crate::error::{Error, Result};
 use crate::raster::RenderScene;
-use crate::raster::{Frame, RenderSettings, ResolvedLight, Shading, camera_setup};
+use crate::raster::{
+    Frame, PbrLight, PreparedSlot, RenderSettings, ResolvedLight, Shading, ToneMapping,
+    camera_setup,
+};
 use crate::scene::Camera;
 
 const VISIBILITY_WGSL: &str = include_str!("shaders/visibility.wgsl");
 const SHADE_WGSL: &str = include_str!("shaders/shade.wgsl");
 
-/// Floats per vertex record (raster.wgsl's `VSTRIDE`).
-const VSTRIDE: usize = 16;
+/// Floats per vertex record (shade.wgsl's and visibility.wgsl's `VSTRIDE`).
+const VSTRIDE: usize = 18;
 const ID_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Uint;
 const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
 
@@ -41,8 +47,8 @@ const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
 const MAX_LIGHTS: usize = 8;
 /// Samples per pixel a GPU frame can hold (shade.wgsl's `MAX_SAMPLES`; the CPU's largest is 8×8).
 const MAX_SAMPLES: usize = 64;
-/// Texel pages (shade.wgsl binds `page0`..`page3`).
-const PAGES: usize = 4;
+/// Texel pages (shade.wgsl binds `page0`..`page7`).
+const PAGES: usize = 8;
 
 /// shade.wgsl's `Globals`.
 #[repr(C)]
@@ -63,14 +69,44 @@ struct Globals {
     width: u32,
     height: u32,
     pad: [u32; 2],
+    plights: [GpuPbrLight; MAX_LIGHTS],
+    eye: [f32; 4],
+    to_eye: [f32; 4],
+    env_x: [f32; 4],
+    env_y: [f32; 4],
+    env_z: [f32; 4],
+    env: [f32; 4],
+    ibl: [u32; 4],
 }
 
+/// shade.wgsl's `PLight`.
+#[repr(C)]
+#[derive(Clone, Copy, Pod, Zeroable)]
+struct GpuPbrLight {
+    pos_kind: [f32; 4],
+    dir_range: [f32; 4],
+    color_inner: [f32; 4],
+    outer: [f32; 4],
+}
+
+/// shade.wgsl's `Slot`.
+#[repr(C)]
+#[derive(Clone, Copy, Pod, Zeroable)]
+struct GpuSlot {
+    tex: [u32; 4],
+    m: [f32; 4],
+    o: [f32; 4],
+}
+
+/// shade.wgsl's `Material`.
 #[repr(C)]
 #[derive(Clone, Copy, Pod, Zeroable)]
 struct GpuMaterial {
     base_color: [f32; 4],
     specular: [f32; 4],
-    tex: [u32; 4],
+    pbr: [f32; 4],
+    emission: [f32; 4],
+    slots: [GpuSlot; 5],
 }
 
 #[repr(C)]
@@ -124,9 +160,17 @@ pub struct GpuScene {
     pages: Vec<wgpu::Buffer>,
     triangle_count: u32,
     flags: u32,
-    lights: Vec<crate::scene::Light>,
+    /// The lights of the Blinn–Phong models and of `pbr`.
+    lights: [Vec<crate::scene::Light>; 2],
     ambient: f32,
     background: Vec3,
+    /// Whether `auto` means `pbr` for this mesh.
+    prefers_pbr: bool,
+    /// World → environment map rotation, and the environment's intensity.
+    to_map: glam::Mat3,
+    environment_intensity: f32,
+    /// First level of the prefiltered chain (then the irradiance map), and the BRDF table's.
+    ibl_levels: [u32; 2],
 }
 
 impl GpuScene {
@@ -163,6 +207,9 @@ impl GpuScene {
             let c = mesh.colors().map_or(Vec3::ONE, |c| c[v]);
             rec[10..13].copy_from_slice(&c.to_array());
             rec[13..16].copy_from_slice(&t.truncate().to_array());
+            if let Some(uvs) = mesh.uvs1() {
+                rec[16..18].copy_from_slice(&uvs[v].to_array());
+            }
         }
         let tris: Vec<[u32; 4]> = mesh
             .triangles()
@@ -176,13 +223,14 @@ impl GpuScene {
         let mut levels: Vec<GpuLevel> = Vec::new();
         let mut pages: Vec<Vec<[f32; 4]>> = vec![Vec::new()];
         let mut placed: Vec<(*const crate::raster::MipTexture, [u32; 2])> = Vec::new();
-        let mut place = |t: &Option<Arc<crate::raster::MipTexture>>| -> Result<[u32; 2]> {
-            let Some(t) = t else { return Ok([0, 0]) };
-            if let Some((_, at)) = placed.iter().find(|(p, _)| *p == Arc::as_ptr(t)) {
+        let mut place_levels = |key: *const crate::raster::MipTexture,
+                                all: &mut dyn Iterator<Item = (usize, usize, &[Vec3])>|
+         -> Result<[u32; 2]> {
+            if let Some((_, at)) = placed.iter().find(|(p, _)| *p == key) {
                 return Ok(*at);
             }
             let first = levels.len() as u32;
-            for (w, h, px) in t.levels() {
+            for (w, h, px) in all {
                 if px.len() > page_texels {
                     return Err(too_big(w, h));
                 }
@@ -203,19 +251,58 @@ impl GpuScene {
                 page.extend(px.iter().map(|c| c.extend(1.0).to_array()));
             }
             let at = [first, levels.len() as u32 - first];
-            placed.push((Arc::as_ptr(t), at));
+            if !key.is_null() {
+                placed.push((key, at));
+            }
             Ok(at)
         };
         let mut materials = Vec::with_capacity(mesh.materials().len());
         for (m, p) in mesh.materials().iter().zip(&prepared.materials) {
-            let base = place(&p.base)?;
-            let normal = place(&p.normal)?;
+            let mut slots = [GpuSlot::zeroed(); 5];
+            let prepared_slots = [
+                &p.base,
+                &p.metallic_roughness,
+                &p.normal,
+                &p.occlusion,
+                &p.emissive,
+            ];
+            for (out, s) in slots.iter_mut().zip(prepared_slots) {
+                if let Some(s) = s {
+                    let at = place_levels(Arc::as_ptr(&s.mip), &mut s.mip.levels())?;
+                    *out = gpu_slot(s, at);
+                }
+            }
             materials.push(GpuMaterial {
-                base_color: m.base_color.extend(1.0).to_array(),
+                base_color: m.base_color.extend(m.base_alpha).to_array(),
                 specular: m.specular.extend(m.shininess).to_array(),
-                tex: [base[0], base[1], normal[0], normal[1]],
+                pbr: [
+                    m.metallic,
+                    m.roughness,
+                    m.normal_scale,
+                    m.occlusion_strength,
+                ],
+                emission: m
+                    .emission()
+                    .extend(if m.double_sided { 1.0 } else { 0.0 })
+                    .to_array(),
+                slots,
             });
         }
+        // The image-based light: nine prefiltered levels, the irradiance map, the BRDF table.
+        let ibl = crate::raster::ibl::prepared(&scene.environment);
+        let maps = ibl.levels.iter().chain(std::iter::once(&ibl.irradiance));
+        let mut chain = maps.map(|m| (m.width(), m.height(), m.texels()));
+        let chain_at = place_levels(std::ptr::null(), &mut chain)?;
+        let lut: Vec<Vec3> = crate::raster::ibl::BrdfLut::get()
+            .entries()
+            .iter()
+            .map(|e| e.extend(0.0))
+            .collect();
+        let n = crate::raster::ibl::LUT_SIZE;
+        let lut_at = place_levels(
+            std::ptr::null(),
+            &mut std::iter::once((n, n, lut.as_slice())),
+        )?;
         let limit = gpu.device.limits().max_storage_buffer_binding_size;
         if (vertices.len() * 4) as u64 > limit || (tris.len() * 16) as u64 > limit {
             return Err(Error::Usage(format!(
@@ -224,17 +311,20 @@ impl GpuScene {
                 mesh.vertex_count()
             )));
         }
-        if scene.lights.len() > MAX_LIGHTS {
+        let lights = [scene.lights_for(false), scene.lights_for(true)];
+        if let Some(too_many) = lights.iter().find(|l| l.len() > MAX_LIGHTS) {
+            // Blinn–Phong and pbr lights alike are counted against the frame's slots.
             return Err(Error::Usage(format!(
                 "the GPU renderer takes at most {MAX_LIGHTS} lights, the scene has {}; use \
                  --backend cpu",
-                scene.lights.len()
+                too_many.len()
             )));
         }
         pages.resize(PAGES, Vec::new());
         let flags = u32::from(mesh.uvs().is_some())
             | (u32::from(mesh.colors().is_some()) << 1)
-            | (u32::from(prepared.tangents.is_some()) << 2);
+            | (u32::from(prepared.tangents.is_some()) << 2)
+            | (u32::from(mesh.uvs1().is_some()) << 3);
         Ok(GpuScene {
             vertices: gpu.storage("vertices", bytemuck::cast_slice(&vertices)),
             tris: gpu.storage("triangles", bytemuck::cast_slice(&tris)),
@@ -246,9 +336,13 @@ impl GpuScene {
                 .collect(),
             triangle_count: tri_count as u32,
             flags,
-            lights: scene.lights.clone(),
+            lights,
             ambient: scene.ambient,
             background: scene.background,
+            prefers_pbr: mesh.prefers_pbr(),
+            to_map: scene.environment_frame(),
+            environment_intensity: scene.environment_intensity,
+            ibl_levels: [chain_at[0], lut_at[0]],
             gpu,
         })
     }
@@ -268,6 +362,16 @@ impl GpuScene {
 
     fn render_unchecked(&self, camera: &Camera, settings: &RenderSettings) -> Result<Frame> {
         let gpu = &self.gpu;
+        // `auto` becomes the model the mesh's materials call for, as on the CPU.
+        let mut settings = *settings;
+        if settings.shading == Shading::Auto {
+            settings.shading = if self.prefers_pbr {
+                Shading::Pbr
+            } else {
+                Shading::Gouraud
+            };
+        }
+        let settings = &settings;
         let pipelines = gpu.render_pipelines();
         let (w, h) = (settings.width, settings.height);
         let limits = gpu.device.limits();
@@ -285,7 +389,7 @@ impl GpuScene {
         }
         let (mvp, (near, far, perspective)) = camera_setup(camera, w, h);
         let mut lights = [GpuLight::zeroed(); MAX_LIGHTS];
-        let resolved = ResolvedLight::for_camera(&self.lights, camera);
+        let resolved = ResolvedLight::for_camera(&self.lights[0], camera);
         for (out, l) in lights.iter_mut().zip(&resolved) {
             *out = GpuLight {
                 l: l.l.extend(0.0).to_array(),
@@ -298,6 +402,17 @@ impl GpuScene {
         for (out, o) in sample_offsets.iter_mut().zip(&offsets) {
             *out = [to_px(o[0]), to_px(o[1]), 0.0, 0.0];
         }
+        let mut plights = [GpuPbrLight::zeroed(); MAX_LIGHTS];
+        let pbr_lights = PbrLight::for_camera(&self.lights[1], camera);
+        for (out, l) in plights.iter_mut().zip(&pbr_lights) {
+            *out = gpu_pbr_light(l);
+        }
+        let display = settings.display();
+        let perspective_eye = matches!(
+            camera.projection,
+            crate::scene::Projection::Perspective { .. }
+        );
+        let rows = self.to_map.transpose();
         let globals = Globals {
             mvp: mvp.to_cols_array_2d(),
             lights,
@@ -314,6 +429,31 @@ impl GpuScene {
             width: w,
             height: h,
             pad: [0; 2],
+            plights,
+            eye: camera
+                .eye
+                .extend(f32::from(u8::from(perspective_eye)))
+                .to_array(),
+            to_eye: camera.to_eye().extend(0.0).to_array(),
+            env_x: rows.x_axis.extend(0.0).to_array(),
+            env_y: rows.y_axis.extend(0.0).to_array(),
+            env_z: rows.z_axis.extend(0.0).to_array(),
+            env: [
+                self.environment_intensity,
+                f32::from(u8::from(settings.multiple_scattering)),
+                display.scale,
+                0.0,
+            ],
+            ibl: [
+                self.ibl_levels[0],
+                self.ibl_levels[1],
+                pbr_lights.len() as u32,
+                match display.tone_mapping {
+                    ToneMapping::Linear => 0,
+                    ToneMapping::Aces => 1,
+                    ToneMapping::PbrNeutral => 2,
+                },
+            ],
         };
         let globals = gpu.uniform("shading globals", bytemuck::bytes_of(&globals));
         let mvp = gpu.uniform(
@@ -512,6 +652,69 @@ pub(crate) fn build_pipelines(gpu: &Gpu) -> Pipelines {
     }
 }
 
+/// shade.wgsl's `Slot` for a prepared slot placed at levels `at` (first, count).
+fn gpu_slot(s: &PreparedSlot, at: [u32; 2]) -> GpuSlot {
+    use crate::mesh::Wrap;
+    let st = s.sampler;
+    let wrap = |w: Wrap| match w {
+        Wrap::Repeat => 0u32,
+        Wrap::ClampToEdge => 1,
+        Wrap::MirroredRepeat => 2,
+    };
+    let mip = match st.mip {
+        None => 0u32,
+        Some(false) => 1,
+        Some(true) => 2,
+    };
+    let bits = wrap(st.wrap[0])
+        | (wrap(st.wrap[1]) << 2)
+        | (u32::from(st.mag_linear) << 4)
+        | (u32::from(st.min_linear) << 5)
+        | (mip << 6);
+    // The transform as an affine map in lodeval's UV convention.
+    let (m, o) = match &s.transform {
+        None => ([1.0, 0.0, 0.0, 1.0], [0.0; 4]),
+        Some(t) => {
+            let o = t.apply(glam::Vec2::ZERO);
+            let (c0, c1) = (t.apply_vector(glam::Vec2::X), t.apply_vector(glam::Vec2::Y));
+            ([c0.x, c0.y, c1.x, c1.y], [o.x, o.y, 1.0, 0.0])
+        }
+    };
+    GpuSlot {
+        tex: [at[0], at[1], s.set as u32, bits],
+        m,
+        o,
+    }
+}
+
+/// shade.wgsl's `PLight` for a light of the `pbr` model.
+fn gpu_pbr_light(l: &PbrLight) -> GpuPbrLight {
+    let (kind, position, direction, intensity, range, inner, outer) = match *l {
+        PbrLight::Directional { l, irradiance } => (0.0, Vec3::ZERO, l, irradiance, None, 1.0, 1.0),
+        PbrLight::Point {
+            position,
+            intensity,
+            range,
+        } => (1.0, position, Vec3::ZERO, intensity, range, 1.0, 1.0),
+        PbrLight::Spot {
+            position,
+            direction,
+            intensity,
+            range,
+            cos_inner,
+            cos_outer,
+        } => (
+            2.0, position, direction, intensity, range, cos_inner, cos_outer,
+        ),
+    };
+    GpuPbrLight {
+        pos_kind: position.extend(kind).to_array(),
+        dir_range: direction.extend(range.unwrap_or(0.0)).to_array(),
+        color_inner: intensity.extend(inner).to_array(),
+        outer: [outer, 0.0, 0.0, 0.0],
+    }
+}
+
 fn too_big(w: usize, h: usize) -> Error {
     Error::Usage(format!(
         "a {w}x{h} texture level does not fit this GPU's storage-buffer limit (with the scene's \
@@ -527,5 +730,7 @@ fn shading_code(s: Shading) -> u32 {
         Shading::NormalMapped => 3,
         Shading::Normals => 4,
         Shading::Depth => 5,
+        // `auto` is resolved before a frame is shaded.
+        Shading::Pbr | Shading::Auto => 6,
     }
 }

@@ -371,6 +371,12 @@ impl Mesh {
     pub fn materials(&self) -> &[Material] {
         &self.materials
     }
+    /// Whether any material is metallic–roughness (what the `auto` shading draws with `pbr`).
+    pub fn prefers_pbr(&self) -> bool {
+        self.materials
+            .iter()
+            .any(|m| m.model == Model::MetallicRoughness)
+    }
     /// Lights the file declares, world space.
     pub fn lights(&self) -> &[FileLight] {
         &self.lights

@@ -32,7 +32,9 @@ mod clip;
 mod edge;
 mod fixed;
 mod frame;
+pub mod ibl;
 pub mod incremental;
+mod pbr;
 
 mod prepare;
 mod recycle;
@@ -43,19 +45,26 @@ pub(crate) mod shade;
 mod sort_last;
 mod texture;
 pub mod texture_space;
+mod tonemap;
 
 use rayon::prelude::*;
 
 use crate::error::{Error, Result};
+use crate::mesh::Mesh;
 use crate::scene::{Camera, Projection};
 
 pub use frame::{Frame, NO_TRIANGLE, check_sheet, contact_sheet, sheet_dimensions};
+#[cfg(feature = "gpu")]
+pub(crate) use pbr::PbrLight;
 pub use prepare::PreparedMesh;
+#[cfg(feature = "gpu")]
+pub(crate) use prepare::PreparedSlot;
 pub use scene::RenderScene;
 #[cfg(feature = "gpu")]
 pub(crate) use shade::ResolvedLight;
 pub use texture::MipTexture;
 pub use texture_space::{TextureSpace, texture_space};
+pub use tonemap::{DisplayTransform, ToneMapping};
 
 /// Shading models, by the names a config or the CLI uses.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -73,11 +82,18 @@ pub enum Shading {
     Normals,
     /// Debug: linear depth, white near, black far.
     Depth,
+    /// glTF 2.0 metallic–roughness under image-based lighting and punctual lights (`pbr.rs`).
+    Pbr,
+    /// `Pbr` for meshes with a metallic–roughness material (glTF; MTL with PBR keys), `Gouraud`
+    /// otherwise ([`Shading::resolve`]).
+    Auto,
 }
 
 impl Shading {
     /// All models, in the order the CLI lists them.
-    pub const ALL: [Shading; 6] = [
+    pub const ALL: [Shading; 8] = [
+        Shading::Auto,
+        Shading::Pbr,
         Shading::Unlit,
         Shading::Gouraud,
         Shading::Phong,
@@ -94,6 +110,27 @@ impl Shading {
             Shading::NormalMapped => "normal-mapped",
             Shading::Normals => "normals",
             Shading::Depth => "depth",
+            Shading::Pbr => "pbr",
+            Shading::Auto => "auto",
+        }
+    }
+
+    /// The model `Auto` stands for on `mesh` (any other model is itself).
+    pub fn resolve(self, mesh: &Mesh) -> Shading {
+        match self {
+            Shading::Auto if mesh.prefers_pbr() => Shading::Pbr,
+            Shading::Auto => Shading::Gouraud,
+            s => s,
+        }
+    }
+
+    /// The tone mapper this model uses when none is set: Khronos PBR Neutral for `pbr`, `linear`
+    /// (a clamp) for the others.
+    pub fn default_tone_mapping(self) -> ToneMapping {
+        if self == Shading::Pbr {
+            ToneMapping::PbrNeutral
+        } else {
+            ToneMapping::Linear
         }
     }
     /// Parse a config/CLI name.
@@ -173,11 +210,19 @@ pub struct RenderSettings {
     pub height: u32,
     /// Anti-aliasing samples. Default value: `Rotated(2)` (4 samples per pixel).
     pub samples: SamplePattern,
-    /// Shading model. Default value: `Gouraud`.
+    /// Shading model. Default value: `Auto`.
     pub shading: Shading,
     /// Skip triangles facing away from the camera. Default value: false (flipped LOD triangles
     /// must show up).
     pub cull_backfaces: bool,
+    /// Exposure in stops (radiance × 2^exposure before tone mapping). Default value: 0.
+    pub exposure: f32,
+    /// Tone mapper; `None` = the shading model's ([`Shading::default_tone_mapping`]). Default
+    /// value: `None`.
+    pub tone_mapping: Option<ToneMapping>,
+    /// The `pbr` model's multiple-scattering energy compensation (Fdez-Agüera 2019). Default
+    /// value: true.
+    pub multiple_scattering: bool,
 }
 
 impl RenderSettings {
@@ -186,11 +231,24 @@ impl RenderSettings {
         width: 512,
         height: 512,
         samples: SamplePattern::Rotated(2),
-        shading: Shading::Gouraud,
+        shading: Shading::Auto,
         cull_backfaces: false,
+        exposure: 0.0,
+        tone_mapping: None,
+        multiple_scattering: true,
     };
     /// Largest accepted image edge, pixels ([`crate::limits::IMAGE_SIDE`]).
     pub const MAX_SIZE: u32 = crate::limits::IMAGE_SIDE.max as u32;
+
+    /// Exposure and the tone mapper (the shading model's where none is set).
+    pub fn display(&self) -> DisplayTransform {
+        DisplayTransform {
+            scale: self.exposure.exp2(),
+            tone_mapping: self
+                .tone_mapping
+                .unwrap_or(self.shading.default_tone_mapping()),
+        }
+    }
 
     pub(crate) fn check(&self) -> Result<()> {
         if self.width == 0
@@ -208,6 +266,9 @@ impl RenderSettings {
         let n = match self.samples {
             SamplePattern::Ordered(n) | SamplePattern::Rotated(n) => n,
         };
+        if let Some(e) = crate::limits::EXPOSURE_STOPS.refuse(self.exposure as f64) {
+            return Err(Error::Usage(format!("exposure {e}")));
+        }
         if SamplePattern::side_for(n.saturating_mul(n)) != Some(n) {
             return Err(Error::Usage(format!(
                 "{} samples per pixel: use 1, 4, 9, ..., 64 (n×n with n ≤ 8)",

@@ -14,7 +14,7 @@ use super::edge::{self, EMPTY, TileSamples};
 use super::frame::{Frame, NO_TRIANGLE};
 use super::recycle;
 use super::setup::{self, Viewport};
-use super::shade::{ResolvedLight, ShadeContext};
+use super::shade::{PbrFrame, ResolvedLight, ShadeContext};
 use super::sort_last::{self, FrameKeys};
 use super::{RenderSettings, Shading, camera_setup, vertex_lighting};
 use crate::scene::Camera;
@@ -46,6 +46,8 @@ pub(crate) struct Pass {
     /// Lights resolved for the camera.
     pub lights: Vec<ResolvedLight>,
     depth_range: (f32, f32, bool),
+    /// The `pbr` model's frame state, where the (resolved) shading is `Pbr`.
+    pbr: Option<PbrFrame>,
 }
 
 /// Where a resolve writes: one rectangle of a frame, as a row slice of every channel per pixel
@@ -202,6 +204,9 @@ impl Pass {
     ) -> Pass {
         let count_coverage = visibility == Visibility::Counts;
         let mesh = scene.mesh();
+        // `auto` becomes the model the mesh's materials call for.
+        let mut settings = *settings;
+        settings.shading = settings.shading.resolve(mesh);
         let (mvp, depth_range) = camera_setup(camera, settings.width, settings.height);
         let offsets = settings.samples.offsets();
         let span = |k: usize, f: fn(i64, i64) -> i64| {
@@ -237,15 +242,18 @@ impl Pass {
         } else {
             (bin::setup_and_bin(mesh.triangles(), &xf, &planes, vp), None)
         };
+        let pbr = (settings.shading == Shading::Pbr)
+            .then(|| PbrFrame::new(scene, camera, settings.multiple_scattering));
         Pass {
             scene: scene.clone(),
-            settings: *settings,
+            settings,
             binned,
             keys,
             offsets,
             count_coverage,
-            lights: ResolvedLight::for_camera(&scene.lights, camera),
+            lights: ResolvedLight::for_camera(&scene.lights_for(false), camera),
             depth_range,
+            pbr,
         }
     }
 
@@ -266,6 +274,8 @@ impl Pass {
             ambient: self.scene.ambient,
             vertex_light: Cow::Borrowed(&[]),
             depth_range: self.depth_range,
+            pbr: self.pbr.as_ref(),
+            display: self.settings.display(),
         };
         if ctx.shading == Shading::Gouraud {
             ctx.vertex_light = match vertex_light {

@@ -30,6 +30,7 @@ use glam::{Vec2, Vec3};
 use rayon::prelude::*;
 
 use super::frame::NO_TRIANGLE;
+use super::prepare::UvFrames;
 use super::shade::{ResolvedLight, Surface};
 use super::{RenderScene, RenderSettings, SamplePattern, Shading};
 use crate::error::{Error, Result};
@@ -137,7 +138,7 @@ pub fn texture_space(scene: &RenderScene, size: usize) -> Result<TextureSpace> {
         height: side,
         samples: SamplePattern::Ordered(1),
         shading: Shading::Unlit,
-        cull_backfaces: false,
+        ..RenderSettings::DEFAULT
     };
     let flat_scene = RenderScene::of(Arc::new(flat));
     let frame = super::render(&flat_scene, &camera, &settings)?;
@@ -159,7 +160,7 @@ pub fn texture_space(scene: &RenderScene, size: usize) -> Result<TextureSpace> {
         overlapping,
         covered,
     };
-    let lights = &scene.scene().lights;
+    let lights = &scene.scene().lights_for(false);
     let shading = Shading::NormalMapped;
     let (prepared, ambient) = (scene.prepared(), scene.scene().ambient);
     let triangles = &out.triangle;
@@ -205,10 +206,12 @@ pub fn texture_space(scene: &RenderScene, size: usize) -> Result<TextureSpace> {
                     far: 1.5,
                 };
                 resolved.clear();
-                resolved.extend(lights.iter().map(|l| {
-                    let (dir, color) = l.resolve(&viewer);
-                    ResolvedLight::new(dir, color, normal)
-                }));
+                resolved.extend(
+                    lights
+                        .iter()
+                        .filter_map(|l| l.resolve(&viewer))
+                        .map(|(dir, color)| ResolvedLight::new(dir, color, normal)),
+                );
                 let surface = Surface {
                     mesh,
                     prepared,
@@ -216,6 +219,7 @@ pub fn texture_space(scene: &RenderScene, size: usize) -> Result<TextureSpace> {
                     lights: &resolved,
                     ambient,
                     vertex_light: &[],
+                    pbr: None,
                 };
                 bary[x] = b;
                 pos[x] = p;
@@ -223,7 +227,10 @@ pub fn texture_space(scene: &RenderScene, size: usize) -> Result<TextureSpace> {
                 sig[x] = surface.color(
                     t as usize,
                     b,
-                    Some((uv, Vec2::new(step, 0.0), Vec2::new(0.0, -step))),
+                    &UvFrames([
+                        Some((uv, Vec2::new(step, 0.0), Vec2::new(0.0, -step))),
+                        None,
+                    ]),
                 );
             }
         });

@@ -18,6 +18,9 @@
 //!   distances, thread independence, the eval generator, bad requests.
 //! - `optimize`: `lodeval optimize` (Lindstrom–Turk): energy goes down, the vertex count stays,
 //!   the output is identical for 1, 2 and 8 threads; bad input exits 2.
+//! - `pbr`: the `pbr` shading model against known answers (white furnace, mirror sphere, Fresnel,
+//!   emission, normal-map handedness on mirrored UVs), the pinned built-in environment, thread
+//!   independence, and bad environment files and materials.
 //! - `qu_meyer`: `lodeval remesh` (Qu & Meyer): the remesh, its maps and JSON, thread
 //!   independence, the eval generator, the experiment on a tiny config, bad requests.
 //! - `oracles`: metrics against reference implementations (FLIP: NVIDIA's; SSIM/PSNR: scikit-image).
@@ -43,6 +46,7 @@ mod menzel_guthe;
 mod models;
 mod optimize;
 mod oracles;
+mod pbr;
 mod qu_meyer;
 mod raster;
 mod simplify;

@@ -205,7 +205,7 @@ fn spot_with_pbr_mtl_keys_maps_to_the_metallic_roughness_model_and_back() {
 /// BoxTextured with every feature lodeval carries added to its JSON: a second UV set read by the
 /// occlusion map, a texture transform, a named sampler, emissive strength, an alpha mask,
 /// double-sidedness, extras, a kept extension, one that names a texture, and a spot light.
-fn everything_box(dir: &Path) -> PathBuf {
+pub(crate) fn everything_box(dir: &Path) -> PathBuf {
     let src = model("box_textured");
     for f in ["BoxTextured0.bin", "CesiumLogoFlat.png"] {
         std::fs::copy(src.join(f), dir.join(f)).unwrap();

@@ -167,7 +167,9 @@ pub fn export_scene(dir: &Path, scene: &Scene, cameras: &[Camera]) -> Result<()>
         .iter()
         .map(|c| {
             let mvp = c.projection(1.0) * c.view();
-            let (l, color) = scene.lights[0].resolve(c);
+            let (l, color) = scene.lights_for(false)[0]
+                .resolve(c)
+                .expect("the bench scene's light is the headlight");
             serde_json::json!({
                 "mvp": mvp.to_cols_array(),
                 "light_dir": l.to_array(),

@@ -16,8 +16,8 @@ struct Jitter {
     pad: vec2<f32>,
 }
 
-// See render.rs: 16 floats per vertex, position first.
-const VSTRIDE: u32 = 16u;
+// See render.rs: 18 floats per vertex, position first.
+const VSTRIDE: u32 = 18u;
 
 @group(0) @binding(0) var<uniform> g: Globals;
 @group(0) @binding(1) var<storage, read> vertices: array<f32>;

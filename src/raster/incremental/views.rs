@@ -39,7 +39,7 @@ impl LumaViews {
                 base_color: m.base_color,
                 specular: m.specular,
                 shininess: m.shininess,
-                texture: p.base.clone(),
+                texture: p.base.as_ref().map(|s| s.mip.clone()),
             })
             .collect();
         let mut shared = Shared {
@@ -76,7 +76,7 @@ impl LumaViews {
                         cull_backfaces: false,
                         sample_span: [half, half, half, half],
                     },
-                    lights: ResolvedLight::for_camera(&scene.lights, camera),
+                    lights: ResolvedLight::for_camera(&scene.lights_for(false), camera),
                     xf: Vec::new(),
                     light: Vec::new(),
                     pieces: Vec::new(),

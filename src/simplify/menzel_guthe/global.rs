@@ -109,7 +109,7 @@ impl GlobalMasking {
             .par_iter()
             .map(|(camera, light)| {
                 let mut scene = Scene::new(mesh.clone());
-                scene.lights = vec![*light];
+                scene.lights = Some(vec![*light]);
                 scene.ambient = lighting.ambient;
                 let scene = RenderScene::new(scene);
                 let Ok(frame) = raster::render(&scene, camera, &settings) else {

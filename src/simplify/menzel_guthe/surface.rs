@@ -93,8 +93,8 @@ impl Materials {
                 base_color: m.base_color,
                 specular: m.specular,
                 shininess: m.shininess,
-                base: p.base.clone(),
-                normal: p.normal.clone(),
+                base: p.base.as_ref().map(|s| s.mip.clone()),
+                normal: p.normal.as_ref().map(|s| s.mip.clone()),
             })
             .collect();
         Materials { list }

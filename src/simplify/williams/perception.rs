@@ -138,13 +138,11 @@ impl ViewModel {
         let to_eye = camera.to_eye();
         let lights = lights
             .iter()
-            .map(|l| {
-                let (dir, color) = l.resolve(camera);
-                ViewLight {
-                    l: dir,
-                    h: (dir + to_eye).normalize_or_zero(),
-                    y: crate::color::luminance(color),
-                }
+            .filter_map(|l| l.resolve(camera))
+            .map(|(dir, color)| ViewLight {
+                l: dir,
+                h: (dir + to_eye).normalize_or_zero(),
+                y: crate::color::luminance(color),
             })
             .collect();
         let peak = daly_rushmeier(ClampedCsf::daly().peak_frequency());
