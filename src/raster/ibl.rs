@@ -100,14 +100,24 @@ impl EquirectMap {
     }
 
     /// Bilinear sample at map coordinates `uv` (u wraps, v clamps at the poles).
+    #[inline]
     pub fn sample_uv(&self, uv: Vec2) -> Vec3 {
         let x = uv.x * self.width as f32 - 0.5;
         let y = (uv.y * self.height as f32 - 0.5).clamp(0.0, (self.height - 1) as f32);
         let (fx, fy) = (x.floor(), y.floor());
         let (tx, ty) = (x - fx, y - fy);
+        // u ∈ [0, 1] puts fx in −1 … width − 1: one step wraps it (no division). A NaN
+        // coordinate becomes texel 0.
         let w = self.width as i64;
-        let x0 = (fx as i64).rem_euclid(w) as usize;
-        let x1 = (fx as i64 + 1).rem_euclid(w) as usize;
+        let mut x0 = fx as i64;
+        if x0 < 0 {
+            x0 += w;
+        }
+        if x0 >= w {
+            x0 = x0.rem_euclid(w);
+        }
+        let x0 = x0 as usize;
+        let x1 = if x0 + 1 == self.width { 0 } else { x0 + 1 };
         let y0 = fy as usize;
         let y1 = (y0 + 1).min(self.height - 1);
         let t = |xx: usize, yy: usize| self.texels[yy * self.width + xx];

@@ -168,6 +168,8 @@ impl PbrLight {
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct ImageLight<'a> {
     pub prepared: &'a PreparedEnvironment,
+    /// The BRDF table ([`BrdfLut::get`], fetched once per frame).
+    pub lut: &'a BrdfLut,
     pub to_map: Mat3,
     pub intensity: f32,
     /// Fdez-Agüera's multiple-scattering term on (the default) or off.
@@ -179,9 +181,9 @@ fn schlick(f0: Vec3, f90: f32, v_dot_h: f32) -> Vec3 {
 }
 
 /// The sample renderer's `getIBLGGXFresnel`: the split sum's directional albedo of the specular
-/// lobe for F0, with Fdez-Agüera's multiple scattering where asked.
-fn ibl_fresnel(f0: Vec3, n_dot_v: f32, roughness: f32, ms: bool) -> Vec3 {
-    let ab = BrdfLut::get().sample(n_dot_v, roughness);
+/// lobe for F0, with Fdez-Agüera's multiple scattering where asked; `ab` is the BRDF table at
+/// (N·V, roughness).
+fn ibl_fresnel(f0: Vec3, n_dot_v: f32, roughness: f32, ab: glam::Vec2, ms: bool) -> Vec3 {
     let fr = Vec3::splat(1.0 - roughness).max(f0) - f0;
     let k_s = f0 + fr * (1.0 - n_dot_v).powi(5);
     let fss_ess = k_s * ab.x + Vec3::splat(ab.y);
@@ -203,8 +205,9 @@ pub(crate) fn shade(s: &SurfacePoint, ibl: &ImageLight, lights: &[PbrLight]) -> 
     let diffuse = ibl.prepared.diffuse(ibl.to_map * s.n) * ibl.intensity * s.base;
     let specular = ibl.prepared.specular(ibl.to_map * r, s.roughness) * ibl.intensity;
     let ms = ibl.multiple_scattering;
-    let metal = ibl_fresnel(s.base, n_dot_v, s.roughness, ms) * specular;
-    let dielectric_f = ibl_fresnel(dielectric_f0, n_dot_v, s.roughness, ms);
+    let ab = ibl.lut.sample(n_dot_v, s.roughness);
+    let metal = ibl_fresnel(s.base, n_dot_v, s.roughness, ab, ms) * specular;
+    let dielectric_f = ibl_fresnel(dielectric_f0, n_dot_v, s.roughness, ab, ms);
     let dielectric = diffuse + (specular - diffuse) * dielectric_f;
     let mut color = (dielectric + (metal - dielectric) * s.metallic) * s.occlusion;
     // Punctual lights.
@@ -256,6 +259,7 @@ mod tests {
         for ms in [true, false] {
             let ibl = ImageLight {
                 prepared: &p,
+                lut: BrdfLut::get(),
                 to_map: Mat3::IDENTITY,
                 intensity: 1.0,
                 multiple_scattering: ms,
@@ -284,6 +288,7 @@ mod tests {
         let p = prepared(&env);
         let ibl = ImageLight {
             prepared: &p,
+            lut: BrdfLut::get(),
             to_map: Mat3::IDENTITY,
             intensity: 1.0,
             multiple_scattering: true,
@@ -302,6 +307,7 @@ mod tests {
         let p = prepared(&dark);
         let ibl = ImageLight {
             prepared: &p,
+            lut: BrdfLut::get(),
             to_map: Mat3::IDENTITY,
             intensity: 1.0,
             multiple_scattering: true,
@@ -332,6 +338,7 @@ mod tests {
         let p = prepared(&dark);
         let ibl = ImageLight {
             prepared: &p,
+            lut: BrdfLut::get(),
             to_map: Mat3::IDENTITY,
             intensity: 1.0,
             multiple_scattering: true,

@@ -154,6 +154,7 @@ pub(crate) fn source_barycentrics(st: &SetupTri, corners: &Corners, x: f64, y: f
 #[derive(Debug)]
 pub(crate) struct PbrFrame {
     pub lights: Vec<PbrLight>,
+    pub lut: &'static super::ibl::BrdfLut,
     pub environment: Arc<PreparedEnvironment>,
     /// World → environment map frame.
     pub to_map: Mat3,
@@ -173,6 +174,7 @@ impl PbrFrame {
     ) -> PbrFrame {
         PbrFrame {
             lights: PbrLight::for_camera(&scene.lights_for(true), camera),
+            lut: super::ibl::BrdfLut::get(),
             environment: super::ibl::prepared(&scene.environment),
             to_map: scene.environment_frame(),
             intensity: scene.environment_intensity,
@@ -354,8 +356,9 @@ impl Surface<'_> {
         let n = self.mesh.normals();
         let mut normal = (n[tri[0]] * b.x + n[tri[1]] * b.y + n[tri[2]] * b.z).normalize_or_zero();
         // The back of a double-sided material is lit as its front (glTF §3.9.6).
-        let face = (p[tri[1]] - p[tri[0]]).cross(p[tri[2]] - p[tri[0]]);
-        if material.double_sided && face.dot(v) < 0.0 {
+        if material.double_sided
+            && (p[tri[1]] - p[tri[0]]).cross(p[tri[2]] - p[tri[0]]).dot(v) < 0.0
+        {
             normal = -normal;
         }
         normal = self.normal_mapped(t, b, frames, normal);
@@ -389,6 +392,7 @@ impl Surface<'_> {
         };
         let image = ImageLight {
             prepared: &frame.environment,
+            lut: frame.lut,
             to_map: frame.to_map,
             intensity: frame.intensity,
             multiple_scattering: frame.multiple_scattering,

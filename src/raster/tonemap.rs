@@ -50,15 +50,19 @@ impl ToneMapping {
         Self::ALL.into_iter().find(|t| t.name() == name)
     }
 
-    /// Map scene-linear `c` (after exposure) to display-linear [0, 1].
+    /// Map scene-linear `c` (after exposure) to display-linear [0, 1]. A NaN becomes 0 and +∞
+    /// 1 (`f32::max` and `min` return the number where one operand is NaN).
+    #[inline]
+    // max/min, not clamp: clamp passes a NaN through, and no NaN may reach a frame.
+    #[allow(clippy::manual_clamp)]
     pub fn apply(self, c: [f32; 3]) -> [f32; 3] {
-        let c = c.map(|v| if v.is_finite() { v.max(0.0) } else { 0.0 });
+        let c = c.map(|v| v.max(0.0).min(f32::MAX));
         let out = match self {
             ToneMapping::Linear => c,
             ToneMapping::Aces => aces_hill(c),
             ToneMapping::PbrNeutral => pbr_neutral(c),
         };
-        out.map(|v| v.clamp(0.0, 1.0))
+        out.map(|v| v.max(0.0).min(1.0))
     }
 }
 

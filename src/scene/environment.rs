@@ -161,11 +161,17 @@ impl Environment {
         self.key
     }
 
-    /// The map coordinates (u, v ∈ [0, 1], v from the top) of world direction `d`.
+    /// The map coordinates (u, v ∈ [0, 1], v from the top) of world direction `d` (any length;
+    /// zero looks up): u = ½ + atan2(−z, −x)/2π, v = acos(y/|d|)/π, with the polynomials of
+    /// [`atan2`] and [`acos`] (the shading hot path; the GPU mirror evaluates the same ones).
+    #[inline]
     pub fn uv_of(d: Vec3) -> Vec2 {
-        let d = d.normalize_or(Vec3::Y);
-        let u = 0.5 + (-d.z).atan2(-d.x) * (0.5 / std::f32::consts::PI);
-        let v = 0.5 - d.y.clamp(-1.0, 1.0).asin() / std::f32::consts::PI;
+        let len = d.length();
+        if len.is_nan() || len <= 0.0 {
+            return Vec2::new(0.5, 0.0);
+        }
+        let u = 0.5 + atan2(-d.z, -d.x) * (0.5 / std::f32::consts::PI);
+        let v = acos(d.y / len) * std::f32::consts::FRAC_1_PI;
         Vec2::new(u, v)
     }
 
@@ -178,6 +184,49 @@ impl Environment {
         // atan2(−z, −x) = φ  ⇒  −x = cos φ, −z = sin φ (scaled by cos θ).
         Vec3::new(-cp * ct, st, -sp * ct)
     }
+}
+
+/// atan2(y, x) in (−π, π] by a degree-11 odd minimax polynomial for atan on [0, 1] (error below
+/// 2·10⁻⁶ rad, far under a texel of the 512-wide map), with the octant reduced by |y| ≤ |x| swaps
+/// and signs: several times faster than the C library's, and the same operations on every
+/// platform and in the GPU mirror's shader.
+#[inline]
+pub fn atan2(y: f32, x: f32) -> f32 {
+    use std::f32::consts::{FRAC_PI_2, PI};
+    let (ax, ay) = (x.abs(), y.abs());
+    let (num, den) = if ay > ax { (ax, ay) } else { (ay, ax) };
+    if den == 0.0 {
+        return 0.0;
+    }
+    let z = num / den;
+    let z2 = z * z;
+    let mut a = z
+        * (0.999_977_3
+            + z2 * (-0.332_623_5
+                + z2 * (0.193_543_5
+                    + z2 * (-0.116_432_9 + z2 * (0.052_653_3 - z2 * 0.011_721_2)))));
+    if ay > ax {
+        a = FRAC_PI_2 - a;
+    }
+    if x < 0.0 {
+        a = PI - a;
+    }
+    if y < 0.0 { -a } else { a }
+}
+
+/// acos(y) for y in [−1, 1] (clamped) by Abramowitz & Stegun 4.4.46: √(1 − |y|) times a
+/// degree-7 polynomial, error below 2·10⁻⁷ rad; π minus it for negative y.
+#[inline]
+pub fn acos(y: f32) -> f32 {
+    let a = y.abs().min(1.0);
+    let p = std::f32::consts::FRAC_PI_2
+        + a * (-0.214_598_8
+            + a * (0.088_978_99
+                + a * (-0.050_174_3
+                    + a * (0.030_891_88
+                        + a * (-0.017_088_1 + a * (0.006_670_09 - a * 0.001_262_491))))));
+    let r = (1.0 - a).sqrt() * p;
+    if y < 0.0 { std::f32::consts::PI - r } else { r }
 }
 
 /// SHA-256 of the size and texel bits, folded to 64 bits.
@@ -332,6 +381,27 @@ fn neutral_room(width: usize) -> Environment {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_fast_atan2_is_within_two_microradians_of_the_library() {
+        let mut worst = 0.0f32;
+        for i in 0..2000 {
+            let a = (i as f32 / 1000.0 - 1.0) * std::f32::consts::PI;
+            for r in [1e-3, 1.0, 1e3] {
+                let (y, x) = (a.sin() * r, a.cos() * r);
+                worst = worst.max((atan2(y, x) - y.atan2(x)).abs());
+            }
+        }
+        assert!(worst < 2e-6, "{worst}");
+        assert_eq!(atan2(0.0, 0.0), 0.0);
+        let worst = (0..=2000)
+            .map(|i| {
+                let y = i as f32 / 1000.0 - 1.0;
+                (acos(y) - y.acos()).abs()
+            })
+            .fold(0.0f32, f32::max);
+        assert!(worst < 1e-6, "acos: {worst}");
+    }
 
     #[test]
     fn directions_and_map_coordinates_invert_each_other() {

@@ -376,13 +376,40 @@ fn normal_mapped(material: Material, v: vec3<u32>, b: vec3<f32>, f: Frames, n: v
 
 // ---- The pbr model (src/raster/pbr.rs, ibl.rs) ----
 
-// Map coordinates of a direction in the environment's frame (scene/environment.rs).
+// scene/environment.rs's atan2: a degree-11 odd polynomial on [0, 1], octants by swaps/signs.
+fn poly_atan2(y: f32, x: f32) -> f32 {
+    let ax = abs(x);
+    let ay = abs(y);
+    let swap = ay > ax;
+    let num = select(ay, ax, swap);
+    let den = select(ax, ay, swap);
+    if (den == 0.0) { return 0.0; }
+    let z = num / den;
+    let z2 = z * z;
+    var a = z * (0.9999773 + z2 * (-0.3326235 + z2 * (0.1935435 + z2 * (-0.1164329
+        + z2 * (0.0526533 - z2 * 0.0117212)))));
+    if (swap) { a = 1.5707964 - a; }
+    if (x < 0.0) { a = PI - a; }
+    if (y < 0.0) { return -a; }
+    return a;
+}
+
+// scene/environment.rs's acos (Abramowitz & Stegun 4.4.46).
+fn poly_acos(y: f32) -> f32 {
+    let a = min(abs(y), 1.0);
+    let p = 1.5707963 + a * (-0.2145988 + a * (0.08897899 + a * (-0.0501743
+        + a * (0.03089188 + a * (-0.0170881 + a * (0.00667009 - a * 0.001262491))))));
+    let r = sqrt(1.0 - a) * p;
+    if (y < 0.0) { return PI - r; }
+    return r;
+}
+
+// Map coordinates of a direction in the environment's frame (scene/environment.rs's uv_of).
 fn equirect_uv(d: vec3<f32>) -> vec2<f32> {
-    var n = vec3<f32>(0.0, 1.0, 0.0);
     let l = length(d);
-    if (l > 0.0) { n = d / l; }
-    let u = 0.5 + atan2(-n.z, -n.x) * (0.5 / PI);
-    let v = 0.5 - asin(clamp(n.y, -1.0, 1.0)) / PI;
+    if (!(l > 0.0)) { return vec2<f32>(0.5, 0.0); }
+    let u = 0.5 + poly_atan2(-d.z, -d.x) * (0.5 / PI);
+    let v = poly_acos(d.y / l) * (1.0 / PI);
     return vec2<f32>(u, v);
 }
 
