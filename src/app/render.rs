@@ -50,6 +50,22 @@ pub struct RenderJob {
     pub backend: crate::backend::Backend,
     /// The `pbr` model's image-based lighting.
     pub lighting: crate::scene::Lighting,
+    /// Also write every view's camera here as JSON (eye, target, up, vertical field of view,
+    /// near, far), to set the same view up in another renderer.
+    pub cameras_json: Option<PathBuf>,
+}
+
+/// One camera as `--cameras` writes it.
+#[derive(Debug, Clone, serde::Serialize)]
+struct CameraJson {
+    view: usize,
+    eye: [f32; 3],
+    target: [f32; 3],
+    up: [f32; 3],
+    /// Vertical field of view, degrees (`null` for an orthographic camera).
+    fov_y_deg: Option<f32>,
+    near: f32,
+    far: f32,
 }
 
 pub(crate) fn write_frame(path: &Path, frame: &Frame, exr: bool) -> Result<()> {
@@ -101,12 +117,35 @@ pub fn render(job: &RenderJob) -> Result<RenderReport> {
             .map(|k| out_dir.join(format!("view-{k:02}.png")))
             .collect(),
     };
-    let outputs: Vec<PathBuf> = pngs
+    let mut outputs: Vec<PathBuf> = pngs
         .iter()
         .flat_map(|p| std::iter::once(p.clone()).chain(job.exr.then(|| p.with_extension("exr"))))
         .collect();
+    outputs.extend(job.cameras_json.clone());
     crate::io::check_not_inputs(&outputs, &mesh.source().files)?;
     let mut written = Vec::new();
+    if let Some(path) = &job.cameras_json {
+        let json: Vec<CameraJson> = cameras
+            .iter()
+            .enumerate()
+            .map(|(view, c)| CameraJson {
+                view,
+                eye: c.eye.to_array(),
+                target: c.target.to_array(),
+                up: c.up.to_array(),
+                fov_y_deg: match c.projection {
+                    crate::scene::Projection::Perspective { fov_y_deg } => Some(fov_y_deg),
+                    _ => None,
+                },
+                near: c.near,
+                far: c.far,
+            })
+            .collect();
+        let text = serde_json::to_vec_pretty(&json)
+            .map_err(|e| Error::Internal(format!("cameras as JSON: {e}")))?;
+        crate::io::write_atomic(path, &text)?;
+        written.push(path.clone());
+    }
     match &job.views {
         ViewSelection::One { view, out } => {
             let camera = cameras.get(*view).ok_or_else(|| {

@@ -170,13 +170,13 @@ pub(crate) struct LookArgs {
     #[arg(long, default_value = "neutral", value_name = "neutral|PATH")]
     pub(crate) environment: String,
     /// Rotation of the environment about the up axis, degrees.
-    #[arg(long, default_value_t = 0.0, value_parser = finite, value_name = "DEGREES")]
+    #[arg(long, default_value_t = 0.0, value_parser = finite, value_name = "DEGREES", allow_negative_numbers = true)]
     pub(crate) environment_rotation: f64,
     /// Factor on the environment's radiance.
     #[arg(long, default_value_t = 1.0, value_parser = value(&lodeval::limits::ENVIRONMENT_INTENSITY))]
     pub(crate) environment_intensity: f64,
     /// Exposure in stops (radiance × 2^STOPS before tone mapping).
-    #[arg(long, default_value_t = 0.0, value_parser = value(&lodeval::limits::EXPOSURE_STOPS), value_name = "STOPS")]
+    #[arg(long, default_value_t = 0.0, value_parser = value(&lodeval::limits::EXPOSURE_STOPS), value_name = "STOPS", allow_negative_numbers = true)]
     pub(crate) exposure: f64,
     /// Tone mapper: linear (a clamp), aces (Hill's fit) or pbr-neutral (Khronos). Default:
     /// pbr-neutral for the pbr model, linear for the others.

@@ -59,6 +59,10 @@ pub(crate) struct RenderArgs {
     /// Also write linear float EXR beside each PNG.
     #[arg(long)]
     pub(crate) exr: bool,
+    /// Also write every view's camera (eye, target, up, field of view, near, far) to this JSON
+    /// file, to set the same views up in another renderer.
+    #[arg(long, value_name = "FILE.json")]
+    pub(crate) cameras: Option<PathBuf>,
     /// Renderer: cpu (the reference), gpu (the wgpu mirror; needs the `gpu` feature and an
     /// adapter) or auto (gpu when available).
     #[arg(long, value_enum, default_value_t = BackendArg::Cpu)]
@@ -101,6 +105,7 @@ impl RenderArgs {
             exr: self.exr,
             backend: self.backend.into(),
             lighting,
+            cameras_json: self.cameras,
         })
     }
 }

@@ -4,13 +4,15 @@
 //! `raster/ibl.rs`).
 //!
 //! Based on: Greg Ward. Real Pixels. Graphics Gems II, 1991 (the RGBE format, read by `image`);
-//! the equirectangular (latitude–longitude) mapping as Blender's world shader uses it, so a
-//! file lights a glTF scene the same way in both (Blender turns glTF's Y-up into its Z-up:
-//! x → x, y → z, z → −y).
+//! the equirectangular (latitude–longitude) mapping as Blender's Cycles
+//! (`direction_to_equirectangular`: u = ½ − atan2(y, x)/2π in its Z-up frame) and three.js use
+//! it, so a file lights a glTF scene the same way in all three (Blender turns glTF's Y-up into its
+//! Z-up: x → x, y → z, z → −y). Checked against Blender with an axis-coloured map
+//! (`examples/export_environment.rs axes`).
 //!
 //! Conventions: directions are in glTF's world space (+Y up). Texel (x, y) of a W × H map covers
 //! u = (x + ½)/W, v = (y + ½)/H with row 0 at the top; direction d has
-//! u = ½ + atan2(−d.z, −d.x) / 2π (the map's centre looks along −X) and v = ½ − asin(d.y) / π.
+//! u = ½ + atan2(d.z, d.x) / 2π (the map's centre looks along +X) and v = acos(d.y) / π.
 //!
 //! Decisions:
 //! - A loaded map must be 2:1 (equirectangular), at least 16 × 8 and at most
@@ -162,7 +164,7 @@ impl Environment {
     }
 
     /// The map coordinates (u, v ∈ [0, 1], v from the top) of world direction `d` (any length;
-    /// zero looks up): u = ½ + atan2(−z, −x)/2π, v = acos(y/|d|)/π, with the polynomials of
+    /// zero looks up): u = ½ + atan2(z, x)/2π, v = acos(y/|d|)/π, with the polynomials of
     /// [`atan2`] and [`acos`] (the shading hot path; the GPU mirror evaluates the same ones).
     #[inline]
     pub fn uv_of(d: Vec3) -> Vec2 {
@@ -170,7 +172,7 @@ impl Environment {
         if len.is_nan() || len <= 0.0 {
             return Vec2::new(0.5, 0.0);
         }
-        let u = 0.5 + atan2(-d.z, -d.x) * (0.5 / std::f32::consts::PI);
+        let u = 0.5 + atan2(d.z, d.x) * (0.5 / std::f32::consts::PI);
         let v = acos(d.y / len) * std::f32::consts::FRAC_1_PI;
         Vec2::new(u, v)
     }
@@ -181,8 +183,8 @@ impl Environment {
         let theta = (0.5 - uv.y) * std::f32::consts::PI;
         let (sp, cp) = phi.sin_cos();
         let (st, ct) = theta.sin_cos();
-        // atan2(−z, −x) = φ  ⇒  −x = cos φ, −z = sin φ (scaled by cos θ).
-        Vec3::new(-cp * ct, st, -sp * ct)
+        // atan2(z, x) = φ  ⇒  x = cos φ, z = sin φ (scaled by cos θ).
+        Vec3::new(cp * ct, st, sp * ct)
     }
 }
 
@@ -414,9 +416,12 @@ mod tests {
             let back = Environment::direction_of(Environment::uv_of(d));
             assert!(back.distance(d) < 1e-5, "{d} → {back}");
         }
-        // The map's centre looks along −X (Blender's convention); the top row is up.
+        // The map's centre looks along +X (Blender's and three.js's convention), a quarter turn
+        // left of it along −Z; the top row is up.
         let centre = Environment::direction_of(Vec2::new(0.5, 0.5));
-        assert!(centre.distance(-Vec3::X) < 1e-6, "{centre}");
+        assert!(centre.distance(Vec3::X) < 1e-6, "{centre}");
+        let quarter = Environment::direction_of(Vec2::new(0.25, 0.5));
+        assert!(quarter.distance(-Vec3::Z) < 1e-6, "{quarter}");
         assert!(Environment::uv_of(Vec3::Y).y < 1e-6);
     }
 

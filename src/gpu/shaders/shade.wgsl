@@ -408,7 +408,7 @@ fn poly_acos(y: f32) -> f32 {
 fn equirect_uv(d: vec3<f32>) -> vec2<f32> {
     let l = length(d);
     if (!(l > 0.0)) { return vec2<f32>(0.5, 0.0); }
-    let u = 0.5 + poly_atan2(-d.z, -d.x) * (0.5 / PI);
+    let u = 0.5 + poly_atan2(d.z, d.x) * (0.5 / PI);
     let v = poly_acos(d.y / l) * (1.0 / PI);
     return vec2<f32>(u, v);
 }
@@ -534,6 +534,10 @@ fn pbr_shade(base: vec3<f32>, metallic: f32, roughness: f32, n: vec3<f32>, v: ve
     var r = 2.0 * dot(n, v) * n - v;
     let rl = length(r);
     if (rl > 0.0) { r = r / rl; } else { r = n; }
+    // The rough lobe's dominant direction (pbr.rs).
+    r = r + (n - r) * (roughness * roughness);
+    let rl2 = length(r);
+    if (rl2 > 0.0) { r = r / rl2; } else { r = n; }
     let diffuse = ibl_diffuse_at(to_map(n)) * g.env.x * base;
     let specular = ibl_specular(to_map(r), roughness) * g.env.x;
     let ab = brdf_lut(n_dot_v, roughness);
