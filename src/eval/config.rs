@@ -199,7 +199,7 @@ impl RenderConfig {
     }
 
     /// The scene lights: the configured ones, or `None` for the default of the model that
-    /// draws the scene ([`Scene::default_lights`]).
+    /// draws the scene ([`crate::scene::Scene::default_lights`]).
     pub fn scene_lights(&self) -> Option<Vec<Light>> {
         self.lights
             .as_ref()

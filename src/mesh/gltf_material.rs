@@ -254,6 +254,13 @@ pub(super) fn load(m: &gltf::Material, index: usize, images: &mut Images) -> Res
         gltf::material::AlphaMode::Blend => AlphaMode::Blend,
     };
     mat.alpha_cutoff = m.alpha_cutoff().unwrap_or(0.5);
+    if mat.alpha_mode != AlphaMode::Opaque {
+        images.warnings.push(format!(
+            "material '{name}': alpha mode {:?} is kept for export, but lodeval draws the material \
+             opaque (alpha testing and blending are not implemented)",
+            mat.alpha_mode
+        ));
+    }
     mat.double_sided = m.double_sided();
     mat.extras = m
         .extras()

@@ -98,6 +98,11 @@ pub(super) fn material(
     if let Some(d) = m.dissolve.filter(|&d| d < 1.0) {
         mat.base_alpha = d;
         mat.alpha_mode = AlphaMode::Blend;
+        warnings.push(format!(
+            "material '{}': d = {d} (alpha blending) is kept for export, but lodeval draws the \
+             material opaque",
+            m.name
+        ));
     }
     if m.dissolve_texture.is_some() {
         warnings.push(format!(

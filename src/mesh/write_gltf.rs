@@ -158,17 +158,7 @@ fn image_files(stem: &str, images: &[ImageOut]) -> Vec<String> {
     images
         .iter()
         .map(|im| {
-            let base: String = im
-                .name
-                .chars()
-                .map(|c| {
-                    if c.is_ascii_alphanumeric() || "-_.".contains(c) {
-                        c
-                    } else {
-                        '_'
-                    }
-                })
-                .collect();
+            let base = super::write_obj::file_safe(&im.name);
             let mut name = format!("{stem}-{base}.{}", im.extension());
             let mut k = 1;
             while !used.insert(name.clone()) {

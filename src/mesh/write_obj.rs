@@ -265,9 +265,10 @@ fn write_faces(mesh: &Mesh, obj: &mut String) {
     }
 }
 
-fn safe(name: &str, i: usize) -> String {
-    let s: String = name
-        .chars()
+/// `name` with every character other than ASCII letters, digits, `-`, `_` and `.` replaced by `_`:
+/// safe in a file name and an MTL statement.
+pub(super) fn file_safe(name: &str) -> String {
+    name.chars()
         .map(|c| {
             if c.is_ascii_alphanumeric() || "-_.".contains(c) {
                 c
@@ -275,7 +276,11 @@ fn safe(name: &str, i: usize) -> String {
                 '_'
             }
         })
-        .collect();
+        .collect()
+}
+
+fn safe(name: &str, i: usize) -> String {
+    let s = file_safe(name);
     if s.is_empty() {
         format!("material{i}")
     } else {

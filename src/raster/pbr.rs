@@ -247,6 +247,18 @@ mod tests {
     use crate::raster::ibl::prepared;
     use crate::scene::Environment;
 
+    /// The image light of a prepared environment: no rotation, intensity 1, multiple scattering
+    /// as asked.
+    fn light_of(p: &PreparedEnvironment, multiple_scattering: bool) -> ImageLight<'_> {
+        ImageLight {
+            prepared: p,
+            lut: BrdfLut::get(),
+            to_map: Mat3::IDENTITY,
+            intensity: 1.0,
+            multiple_scattering,
+        }
+    }
+
     fn point(base: f32, metallic: f32, roughness: f32, n_dot_v: f32) -> SurfacePoint {
         SurfacePoint {
             base: Vec3::splat(base),
@@ -268,13 +280,7 @@ mod tests {
         let p = prepared(&env);
         let mut worst_off = 0.0f32;
         for ms in [true, false] {
-            let ibl = ImageLight {
-                prepared: &p,
-                lut: BrdfLut::get(),
-                to_map: Mat3::IDENTITY,
-                intensity: 1.0,
-                multiple_scattering: ms,
-            };
+            let ibl = light_of(&p, ms);
             for metallic in [0.0, 1.0] {
                 for k in 0..=10 {
                     for n_dot_v in [0.2, 0.6, 1.0] {
@@ -297,13 +303,7 @@ mod tests {
         // A black dielectric under a white sky shows only its Fresnel reflection.
         let env = Environment::uniform(Vec3::ONE).unwrap();
         let p = prepared(&env);
-        let ibl = ImageLight {
-            prepared: &p,
-            lut: BrdfLut::get(),
-            to_map: Mat3::IDENTITY,
-            intensity: 1.0,
-            multiple_scattering: true,
-        };
+        let ibl = light_of(&p, true);
         let at = |nv: f32| shade(&point(0.0, 0.0, 0.2, nv), &ibl, &[]).x;
         let (head_on, grazing) = (at(1.0), at(0.1));
         assert!((head_on - 0.04).abs() < 0.01, "{head_on}");
@@ -316,13 +316,7 @@ mod tests {
         // angle at which the highlight falls to half its peak grows with roughness.
         let dark = Environment::uniform(Vec3::ZERO).unwrap();
         let p = prepared(&dark);
-        let ibl = ImageLight {
-            prepared: &p,
-            lut: BrdfLut::get(),
-            to_map: Mat3::IDENTITY,
-            intensity: 1.0,
-            multiple_scattering: true,
-        };
+        let ibl = light_of(&p, true);
         let light = [PbrLight::Directional {
             l: Vec3::new(-0.5, 0.0, 0.75_f32.sqrt()),
             irradiance: Vec3::ONE,
@@ -347,13 +341,7 @@ mod tests {
     fn emission_alone_is_rendered_exactly() {
         let dark = Environment::uniform(Vec3::ZERO).unwrap();
         let p = prepared(&dark);
-        let ibl = ImageLight {
-            prepared: &p,
-            lut: BrdfLut::get(),
-            to_map: Mat3::IDENTITY,
-            intensity: 1.0,
-            multiple_scattering: true,
-        };
+        let ibl = light_of(&p, true);
         let mut s = point(0.7, 0.3, 0.5, 0.8);
         s.emission = Vec3::new(0.25, 0.5, 1.5);
         assert_eq!(shade(&s, &ibl, &[]), s.emission);

@@ -165,7 +165,7 @@ impl Environment {
 
     /// The map coordinates (u, v ∈ [0, 1], v from the top) of world direction `d` (any length;
     /// zero looks up): u = ½ + atan2(z, x)/2π, v = acos(y/|d|)/π, with the polynomials of
-    /// [`atan2`] and [`acos`] (the shading hot path; the GPU mirror evaluates the same ones).
+    /// `atan2` and `acos` below (the shading hot path; the GPU mirror evaluates the same ones).
     #[inline]
     pub fn uv_of(d: Vec3) -> Vec2 {
         let len = d.length();

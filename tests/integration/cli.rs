@@ -112,12 +112,17 @@ fn ci_runs_the_readme_test_command() {
 #[test]
 fn readme_main_job_is_the_demo_config_and_it_plans_what_the_readme_says() {
     // The quick start's first command runs configs/demo.toml; the config must load (models
-    // shipped, keys valid) and plan the two models × five LODs the README describes.
+    // shipped, keys valid) and plan what the README describes: bunny and Spot × five LODs,
+    // the avocado × two.
     let readme = std::fs::read_to_string(crate::common::root().join("README.md")).unwrap();
     assert!(readme.contains("cargo run --release -- eval configs/demo.toml"));
     let plan = lodeval::eval::Plan::load(&crate::common::root().join("configs/demo.toml")).unwrap();
     let cases = plan.case_ids();
-    assert_eq!(cases.len(), 10, "{cases:?}");
+    assert_eq!(cases.len(), 12, "{cases:?}");
+    assert!(
+        cases.iter().any(|c| c == "avocado/meshopt-r10"),
+        "{cases:?}"
+    );
     for a in &plan.assets {
         assert!(a.mesh.exists(), "{}", a.mesh.display());
     }

@@ -280,8 +280,14 @@ fn every_carried_feature_survives_and_what_cannot_be_carried_is_named() {
     assert_eq!(mat.occlusion_texture.as_ref().unwrap().set(), 1);
     assert!(m.uvs1().is_some());
     assert_eq!(m.lights().len(), 1);
-    // The unmodelled extensions are warned about on load.
+    // The unmodelled extensions, and the alpha mask drawn opaque, are warned about on load.
     let info = lodeval(["info", input.to_str().unwrap()]);
+    assert!(
+        info.stdout
+            .contains("alpha mode Mask is kept for export, but lodeval draws the material opaque"),
+        "{}",
+        info.stdout
+    );
     assert!(
         info.stdout
             .contains("KHR_materials_clearcoat is kept for export but not rendered"),

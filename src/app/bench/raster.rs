@@ -172,6 +172,9 @@ pub fn export_scene(dir: &Path, scene: &Scene, cameras: &[Camera]) -> Result<()>
                 .expect("the bench scene's light is the headlight");
             serde_json::json!({
                 "mvp": mvp.to_cols_array(),
+                "eye": c.eye.to_array(),
+                "metallic": m.metallic,
+                "roughness": m.roughness,
                 "light_dir": l.to_array(),
                 "light_color": color.to_array(),
                 "to_eye": c.to_eye().to_array(),
@@ -184,5 +187,37 @@ pub fn export_scene(dir: &Path, scene: &Scene, cameras: &[Camera]) -> Result<()>
         })
         .collect();
     let json = serde_json::to_string_pretty(&views).map_err(|e| Error::Internal(e.to_string()))?;
-    crate::io::write_atomic(&dir.join("views.json"), json.as_bytes())
+    crate::io::write_atomic(&dir.join("views.json"), json.as_bytes())?;
+    export_ibl(dir, scene)
+}
+
+/// The `pbr` model's prepared environment for the peer: each prefiltered level and the irradiance
+/// map as raw little-endian RGB f32 (`ibl-N.f32`, row 0 at the top), the BRDF table as RG f32
+/// (`brdf.f32`), and their sizes in `ibl.json`.
+fn export_ibl(dir: &Path, scene: &Scene) -> Result<()> {
+    let ibl = crate::raster::ibl::prepared(&scene.environment);
+    let mut maps = Vec::new();
+    for (k, m) in ibl.levels.iter().chain([&ibl.irradiance]).enumerate() {
+        let bytes: Vec<u8> = m
+            .texels()
+            .iter()
+            .flat_map(|t| t.to_array())
+            .flat_map(f32::to_le_bytes)
+            .collect();
+        crate::io::write_atomic(&dir.join(format!("ibl-{k}.f32")), &bytes)?;
+        maps.push([m.width(), m.height()]);
+    }
+    let lut: Vec<u8> = crate::raster::ibl::BrdfLut::get()
+        .entries()
+        .iter()
+        .flat_map(|e| e.to_array())
+        .flat_map(f32::to_le_bytes)
+        .collect();
+    crate::io::write_atomic(&dir.join("brdf.f32"), &lut)?;
+    let json = serde_json::json!({
+        "levels": crate::raster::ibl::LEVELS,
+        "maps": maps,
+        "lut_size": crate::raster::ibl::LUT_SIZE,
+    });
+    crate::io::write_atomic(&dir.join("ibl.json"), json.to_string().as_bytes())
 }
