@@ -25,7 +25,7 @@ impl fmt::Display for Location {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
             Location::Line(n) => write!(f, "line {n}"),
-            Location::Element(e) => f.write_str(e),
+            Location::Element(e) => f.write_str(&cut(e, QUOTE_CHARS * 2)),
         }
     }
 }
@@ -106,15 +106,13 @@ impl fmt::Display for Error {
                 if let Some(loc) = location {
                     write!(f, ", {loc}")?;
                 }
-                // One message, one line: parser messages sometimes carry their own line breaks.
-                let problem: String = problem.split_whitespace().collect::<Vec<_>>().join(" ");
-                write!(f, ": {problem}")?;
+                write!(f, ": {}", one_line(problem, MESSAGE_CHARS))?;
                 if !fix.is_empty() {
-                    write!(f, "; {fix}")?;
+                    write!(f, "; {}", one_line(fix, MESSAGE_CHARS))?;
                 }
                 Ok(())
             }
-            Error::Usage(msg) => f.write_str(msg),
+            Error::Usage(msg) => f.write_str(&one_line(msg, MESSAGE_CHARS)),
             Error::Regression(msg) => f.write_str(msg),
             Error::Internal(msg) => write!(
                 f,
@@ -125,6 +123,49 @@ impl fmt::Display for Error {
 }
 
 impl std::error::Error for Error {}
+
+/// The most characters of one part of a message (the problem, the fix): a message quoting an
+/// input never grows with the input.
+const MESSAGE_CHARS: usize = 2000;
+
+/// The most characters of input text [`quote`] shows.
+const QUOTE_CHARS: usize = 120;
+
+/// `text` on one line (runs of white space, line breaks included, become one space), cut to
+/// `max` characters with a note of how much was left out.
+fn one_line(text: &str, max: usize) -> String {
+    let joined: String = text.split_whitespace().collect::<Vec<_>>().join(" ");
+    cut(&joined, max)
+}
+
+fn cut(text: &str, max: usize) -> String {
+    match text.char_indices().nth(max) {
+        None => text.to_string(),
+        Some((at, _)) => format!("{}… ({} more bytes)", &text[..at], text.len() - at),
+    }
+}
+
+/// Input text as a message quotes it: control characters escaped (a newline is `\n`), at most
+/// a short line long. Every message that repeats what a file or a flag said goes through this.
+pub fn quote(text: &str) -> String {
+    let escaped: String = text
+        .chars()
+        .take(QUOTE_CHARS + 1)
+        .flat_map(|c| {
+            if c.is_control() {
+                c.escape_default().collect::<Vec<_>>()
+            } else {
+                vec![c]
+            }
+        })
+        .collect();
+    if text.chars().nth(QUOTE_CHARS).is_some() {
+        let shown: String = escaped.chars().take(QUOTE_CHARS).collect();
+        format!("{shown}…")
+    } else {
+        escaped
+    }
+}
 
 #[cfg(test)]
 mod tests {

@@ -10,8 +10,14 @@ pub mod finite;
 pub mod label;
 pub mod plot;
 pub mod plot_png;
+pub mod staged;
 
-use std::io::{Read, Write};
+pub use staged::{
+    Staged, disown, forget, interrupted, own, remove_on_interrupt, remove_temporaries,
+    written_under,
+};
+
+use std::io::Read;
 use std::path::{Path, PathBuf};
 
 use crate::error::{Error, Result};
@@ -79,18 +85,61 @@ pub fn read_input_text(path: &Path, what: &str, limit: u64, fix: &str) -> Result
     })
 }
 
-/// `Err` when writing any of `outputs` would replace one of `inputs` (the same file through any
-/// path, symlink or hard link): lodeval never overwrites what it reads (`-o` naming the input
-/// mesh used to replace it). Outputs that do not exist yet pass.
+/// Where writing `path` really lands, as an absolute path: the part that exists is resolved
+/// through the file system (symlinks, `..` after a symlink), the part that does not is resolved
+/// lexically (`missing/../in.obj` is `in.obj`, since the writer creates `missing` as a plain
+/// folder). Every "is this output one of my inputs?" question compares these.
+pub fn target(path: &Path) -> PathBuf {
+    use std::path::Component;
+    let absolute = if path.is_absolute() {
+        path.to_path_buf()
+    } else {
+        std::env::current_dir()
+            .unwrap_or_else(|_| PathBuf::from("/"))
+            .join(path)
+    };
+    let mut out = PathBuf::new();
+    let mut real = true; // `out` exists and is canonical
+    for c in absolute.components() {
+        match c {
+            Component::Prefix(_) | Component::RootDir => out.push(c.as_os_str()),
+            Component::CurDir => {}
+            Component::ParentDir => {
+                out.pop();
+                real = real || out.exists();
+            }
+            Component::Normal(name) => {
+                out.push(name);
+                if real && let Ok(c) = out.canonicalize() {
+                    out = c;
+                } else {
+                    real = false;
+                }
+            }
+        }
+    }
+    out
+}
+
+/// Whether writing `output` would replace `input` (the same file through any path, symlink,
+/// hard link or not-yet-existing folder followed by `..`).
+pub fn same_target(output: &Path, input: &Path) -> bool {
+    let (o, i) = (target(output), target(input));
+    o == i
+        || matches!((std::fs::metadata(&o), std::fs::metadata(&i)),
+            (Ok(a), Ok(b)) if same_file(&a, &b, &o, &i))
+}
+
+/// Whether `path` is `root` or lies inside it, compared by [`target`].
+pub fn within(path: &Path, root: &Path) -> bool {
+    target(path).starts_with(target(root))
+}
+
+/// `Err` when writing any of `outputs` would replace one of `inputs` ([`same_target`]):
+/// lodeval never overwrites what it reads (`-o` naming the input mesh used to replace it).
 pub fn check_not_inputs(outputs: &[PathBuf], inputs: &[PathBuf]) -> Result<()> {
     for out in outputs {
-        let Ok(o) = std::fs::metadata(out) else {
-            continue;
-        };
-        if let Some(input) = inputs
-            .iter()
-            .find(|i| std::fs::metadata(i).is_ok_and(|m| same_file(&o, &m, out, i)))
-        {
+        if let Some(input) = inputs.iter().find(|i| same_target(out, i)) {
             let which = if input == out {
                 String::new()
             } else {
@@ -121,24 +170,9 @@ fn same_file(_: &std::fs::Metadata, _: &std::fs::Metadata, a: &Path, b: &Path) -
 
 /// Write `bytes` to `path` atomically (temp file in the same folder, then rename).
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
-    let dir = match path.parent() {
-        Some(d) if !d.as_os_str().is_empty() => d,
-        _ => Path::new("."),
-    };
-    std::fs::create_dir_all(dir).map_err(|e| cannot_write(path, e))?;
-    let name = path
-        .file_name()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_default();
-    let tmp = dir.join(format!(".{name}.tmp{}", std::process::id()));
-    let result = std::fs::File::create(&tmp)
-        .and_then(|mut f| f.write_all(bytes).and_then(|_| f.sync_all()))
-        .and_then(|_| std::fs::rename(&tmp, path));
-    if let Err(e) = result {
-        let _ = std::fs::remove_file(&tmp);
-        return Err(cannot_write(path, e));
-    }
-    Ok(())
+    let mut staged = Staged::default();
+    staged.write(path, bytes)?;
+    staged.commit()
 }
 
 fn cannot_write(path: &Path, e: std::io::Error) -> Error {
@@ -181,6 +215,11 @@ pub fn resolve(base: &Path, rel: &Path) -> PathBuf {
 
 /// Encode an image in the format its extension names (`.png`, `.exr`) and write it atomically.
 pub fn write_image(path: &Path, image: &image::DynamicImage) -> Result<()> {
+    write_atomic(path, &encode_image(path, image)?)
+}
+
+/// The bytes of `image` in the format `path`'s extension names (`.png`, `.exr`).
+pub fn encode_image(path: &Path, image: &image::DynamicImage) -> Result<Vec<u8>> {
     let format = image::ImageFormat::from_path(path).map_err(|_| {
         Error::Usage(format!(
             "{}: unknown image extension; use .png (or .exr for linear float)",
@@ -191,7 +230,7 @@ pub fn write_image(path: &Path, image: &image::DynamicImage) -> Result<()> {
     image
         .write_to(&mut bytes, format)
         .map_err(|e| Error::Internal(format!("encoding {}: {e}", path.display())))?;
-    write_atomic(path, bytes.get_ref())
+    Ok(bytes.into_inner())
 }
 
 #[cfg(test)]

@@ -51,6 +51,10 @@ fn brief(v: f64) -> String {
     if (1e-3..1e7).contains(&a) {
         let decimals = (5 - a.log10().floor() as i32).max(0) as usize;
         trim(format!("{v:.decimals$}"))
+    } else if format!("{v:e}").trim_start_matches('-').len() <= 12 {
+        // Rust's shortest round-trip form when it is short (`1e-320`: a subnormal printed with
+        // five decimals would show its lost precision, 9.99989e-321).
+        format!("{v:e}")
     } else {
         let t = format!("{v:.5e}");
         let (mantissa, exponent) = t.split_once('e').unwrap_or((&t, "0"));
@@ -175,6 +179,16 @@ pub const GENERATED_TRIANGLES: Bound<u64> = Bound {
     max: 100_000_000,
     unit: "triangles",
     why: "100 million triangles take about 10 GiB once prepared for rendering",
+};
+
+/// Rings and sides of the benchmark torus (`bench raster --rings`, `--sides`): fewer than three
+/// make no closed surface; the triangle count is bounded by [`GENERATED_TRIANGLES`].
+pub const TORUS_SEGMENTS: Bound<u64> = Bound {
+    min: 3,
+    max: 10_000_000,
+    unit: "segments",
+    why: "fewer than three make no torus, and more than ten million rings or sides exceed the \
+          bound of 100 000 000 triangles with any partner",
 };
 
 /// Energy evaluations of the image-driven optimizer (`--evals`): only time grows with it.

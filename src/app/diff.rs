@@ -113,6 +113,80 @@ impl DiffMetric {
     pub fn larger_is_worse(self) -> bool {
         crate::eval::tables::higher_is_worse(self.name())
     }
+
+    /// The values the metric can take: FLIP's mean error and the VDP's probability lie in
+    /// [0, 1], SSIM and MS-SSIM in [−1, 1], MSE is at least 0, PSNR of 8-bit encodings at least
+    /// 0 dB; PSNR of (possibly HDR) luminance is unbounded.
+    pub fn range(self) -> (f64, f64) {
+        match self {
+            DiffMetric::Flip | DiffMetric::Vdp => (0.0, 1.0),
+            DiffMetric::Ssim | DiffMetric::Msssim => (-1.0, 1.0),
+            DiffMetric::Mse | DiffMetric::Psnr => (0.0, f64::INFINITY),
+            DiffMetric::PsnrLuminance => (f64::NEG_INFINITY, f64::INFINITY),
+        }
+    }
+
+    /// `Err` with the reason when `limit` (a `--fail`/`--warn` value named `flag`) makes a gate
+    /// that can never fail, or always does, since no value of the metric lies beyond it.
+    pub fn check_limit(self, flag: &str, limit: f64) -> std::result::Result<(), String> {
+        let (lo, hi) = self.range();
+        let name = self.name();
+        let never = if self.larger_is_worse() {
+            limit >= hi
+        } else {
+            limit <= lo
+        };
+        let always = if self.larger_is_worse() {
+            limit < lo
+        } else {
+            limit > hi
+        };
+        let span = format!("{name} lies in [{lo}, {hi}]");
+        if never {
+            return Err(format!(
+                "{flag} {limit}: {span}, so no result is ever worse than {limit} and the gate \
+                 could never fail; give a limit inside the range"
+            ));
+        }
+        if always {
+            return Err(format!(
+                "{flag} {limit}: {span}, so every result is worse than {limit} and the gate \
+                 would always fail; give a limit inside the range"
+            ));
+        }
+        Ok(())
+    }
+}
+
+impl DiffGates {
+    /// `Err` with the reason when a gate can never fail or always fails for `metric`: a limit
+    /// outside the metric's range, a percentage outside [0, 100), a pixel threshold outside
+    /// [0, 1) of the map's values.
+    pub fn check(&self, metric: DiffMetric) -> std::result::Result<(), String> {
+        for (flag, v) in [("--fail", self.fail), ("--warn", self.warn)] {
+            if let Some(v) = v {
+                metric.check_limit(flag, v)?;
+            }
+        }
+        for (flag, v) in [
+            ("--fail-percent", self.fail_percent),
+            ("--warn-percent", self.warn_percent),
+        ] {
+            if let Some(v) = v.filter(|v| !(0.0..100.0).contains(v)) {
+                return Err(format!(
+                    "{flag} {v}: a share of pixels lies in [0, 100) %; at {v} the gate could \
+                     never fail (or always would)"
+                ));
+            }
+        }
+        if let Some(p) = self.pixel.filter(|p| !(0.0..1.0).contains(p)) {
+            return Err(format!(
+                "--fail-pixel {p}: the per-pixel maps lie in [0, 1], so no pixel would ever be \
+                 counted (or every one would); give a threshold in [0, 1)"
+            ));
+        }
+        Ok(())
+    }
 }
 
 /// Pass/warn/fail limits on one metric, as idiff and NVIDIA's FLIP tool take them.
@@ -144,12 +218,14 @@ pub fn judge(r: &DiffResult, gates: &DiffGates) -> (Option<String>, Option<Strin
         let (limit, v) = (limit?, r.value?);
         worse(v, limit).then(|| {
             format!(
-                "{name} {v:.6} is {} the {verb} limit {limit}",
+                "{name} {} is {} the {verb} limit {}",
+                crate::limits::Quantity::show(v),
                 if r.metric.larger_is_worse() {
                     "above"
                 } else {
                     "below"
-                }
+                },
+                crate::limits::Quantity::show(limit)
             )
         })
     };
@@ -256,6 +332,13 @@ pub fn diff(
         let name = serde_json::to_value(metric).ok()?.as_str()?.to_string();
         Some(p.with_file_name(format!("{stem}-{name}.png")))
     };
+    // No map may replace the images it compares (`--map ref.png`).
+    let maps: Vec<PathBuf> = metrics
+        .iter()
+        .filter(|m| matches!(m, DiffMetric::Flip | DiffMetric::Ssim | DiffMetric::Vdp))
+        .filter_map(|&m| map_path(m))
+        .collect();
+    crate::io::check_not_inputs(&maps, &[reference.to_path_buf(), test.to_path_buf()])?;
     let mut out = Vec::new();
     for &metric in metrics {
         let mut r = DiffResult {

@@ -80,7 +80,15 @@ pub fn remesh(job: &RemeshJob) -> Result<RemeshReport> {
         ..job.options
     };
     let r = qu_meyer::remesh(&input, &options)?;
-    let warnings = mesh::write_obj::write(&r.mesh, &job.out)?;
+    let mut warnings = mesh::write_obj::write(&r.mesh, &job.out)?;
+    // Fewer vertices than asked (a small map has too few texels to place them): said.
+    if (r.vertices as f64) < 0.95 * options.vertices as f64 {
+        warnings.push(format!(
+            "the remesh has {} vertices, short of the {} asked for: the {}² maps have too few \
+             texels inside the charts to place more; raise --map-size",
+            r.vertices, options.vertices, options.map_size
+        ));
+    }
     if let (Some(dir), Some(images)) = (&job.maps, &r.maps) {
         images.write(dir)?;
     }

@@ -106,7 +106,7 @@ pub fn simplify(
         })
         .collect();
     let planned: Vec<PathBuf> = if gltf {
-        vec![job.out.clone(), job.out.with_extension("bin")]
+        crate::mesh::write_gltf::planned_files(&[("original", &mesh)], &job.out)?
     } else {
         files
             .iter()
@@ -266,10 +266,16 @@ pub struct WilliamsJob {
     pub size: u32,
 }
 
-/// Simplify with Williams et al. 2003 and write the LOD as OBJ.
+/// Simplify with Williams et al. 2003 and write the LOD as OBJ, or as a one-level glTF.
 pub fn simplify_williams(job: &WilliamsJob) -> Result<SimplifyReport> {
     use crate::simplify::williams::{Options, Williams};
     let mesh = load_for_lod(&job.mesh, &job.out)?;
+    let planned = if gltf_out(&job.out) {
+        crate::mesh::write_gltf::planned_files(&[("williams", &mesh)], &job.out)?
+    } else {
+        crate::mesh::write_obj::planned_files(&mesh, &job.out)
+    };
+    crate::io::check_not_inputs(&planned, &mesh.source().files)?;
     let start = std::time::Instant::now();
     let w = Williams::build(&mesh)?;
     let opts = Options {
@@ -304,7 +310,12 @@ pub fn simplify_williams(job: &WilliamsJob) -> Result<SimplifyReport> {
     };
     let lod = w.static_lod(&cameras, job.goal, &opts)?;
     let seconds = start.elapsed().as_secs_f64();
-    let warnings = crate::mesh::write_obj::write(&lod, &job.out)?;
+    let warnings = if gltf_out(&job.out) {
+        // One level: the LOD alone, named by its method.
+        crate::mesh::write_gltf::write_lod_chain(&[("williams", &lod)], &[0.0], &job.out)?.warnings
+    } else {
+        crate::mesh::write_obj::write(&lod, &job.out)?
+    };
     Ok(SimplifyReport {
         rows: vec![SimplifyRow {
             file: job.out.clone(),

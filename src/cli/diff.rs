@@ -112,10 +112,12 @@ pub(crate) struct DiffArgs {
     pub(crate) fail_pixel: Option<f64>,
     /// HDR-FLIP (two EXR images): the shortest exposure, in stops (with --stop-exposure and
     /// --num-exposures; default: NVIDIA's automatic range from the reference's peak and median).
-    #[arg(long, allow_negative_numbers = true, requires_all = ["stop_exposure", "num_exposures"])]
+    #[arg(long, allow_negative_numbers = true, requires_all = ["stop_exposure", "num_exposures"],
+          value_parser = value(&lodeval::limits::EXPOSURE_STOPS))]
     pub(crate) start_exposure: Option<f64>,
     /// HDR-FLIP: the longest exposure, in stops.
-    #[arg(long, allow_negative_numbers = true, requires_all = ["start_exposure", "num_exposures"])]
+    #[arg(long, allow_negative_numbers = true, requires_all = ["start_exposure", "num_exposures"],
+          value_parser = value(&lodeval::limits::EXPOSURE_STOPS))]
     pub(crate) stop_exposure: Option<f64>,
     /// HDR-FLIP: the number of exposures, 1 to 64.
     #[arg(long, requires_all = ["start_exposure", "stop_exposure"],
@@ -198,6 +200,23 @@ pub(crate) fn run(a: DiffArgs) -> Result<(), Error> {
             gated.name()
         )));
     }
+    gates.check(gated).map_err(Error::Usage)?;
+    let is_exr = |p: &std::path::Path| {
+        p.extension()
+            .and_then(|e| e.to_str())
+            .is_some_and(|e| e.eq_ignore_ascii_case("exr"))
+    };
+    let all_exr = is_exr(&a.reference) && a.test.iter().all(|t| is_exr(t));
+    if a.start_exposure.is_some() && !(all_exr && metrics.contains(&DiffMetric::Flip)) {
+        warnings(&["--start-exposure, --stop-exposure and --num-exposures apply to HDR-FLIP                     (--metric flip on two EXR images) only; they do nothing here"
+            .to_string()]);
+    }
+    // No output of this run may replace one of its images.
+    let inputs: Vec<PathBuf> = std::iter::once(a.reference.clone())
+        .chain(a.test.iter().cloned())
+        .collect();
+    let outputs: Vec<PathBuf> = a.csv.iter().chain(a.map.iter()).cloned().collect();
+    lodeval::io::check_not_inputs(&outputs, &inputs)?;
     let seen = lodeval::app::Seen { viewing, display };
     let several = a.test.len() > 1;
     let mut all = Vec::new();

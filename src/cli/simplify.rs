@@ -125,12 +125,12 @@ pub(crate) struct SimplifyArgs {
     pub(crate) shading: Shading,
     #[command(flatten)]
     pub(crate) look: LookArgs,
-    /// williams: perceptual, object-space, screen-space or silhouette-10.
-    #[arg(long, value_enum, default_value_t = CriterionArg::Perceptual)]
-    pub(crate) criterion: CriterionArg,
-    /// williams: image size the views are rendered at (pixels).
-    #[arg(long, default_value_t = 512, value_parser = count::<u32>(&lodeval::limits::IMAGE_SIDE))]
-    pub(crate) size: u32,
+    /// williams: perceptual (default), object-space, screen-space or silhouette-10.
+    #[arg(long, value_enum)]
+    pub(crate) criterion: Option<CriterionArg>,
+    /// williams: image size the views are rendered at (pixels; default 512).
+    #[arg(long, value_parser = count::<u32>(&lodeval::limits::IMAGE_SIDE))]
+    pub(crate) size: Option<u32>,
     /// Target ratio of the input's triangles.
     #[arg(long, conflicts_with_all = ["triangles", "error", "chain"])]
     pub(crate) ratio: Option<f64>,
@@ -184,6 +184,24 @@ pub(crate) fn run(a: SimplifyArgs, quiet: bool) -> Result<(), Error> {
             ))?;
         }
         return Ok(());
+    }
+    // Flags of Williams et al. that another method would ignore: said, not silently dropped.
+    let williams_only: Vec<&str> = [
+        ("--camera", !a.camera.is_empty()),
+        ("--view", a.view.is_some()),
+        ("--all-views", a.all_views),
+        ("--criterion", a.criterion.is_some()),
+        ("--size", a.size.is_some()),
+    ]
+    .into_iter()
+    .filter_map(|(flag, given)| given.then_some(flag))
+    .collect();
+    if !williams_only.is_empty() {
+        super::print::warnings(&[format!(
+            "{} apply to --method williams only; they do nothing with {}",
+            williams_only.join(", "),
+            a.method.method().name()
+        )]);
     }
     use lodeval::simplify::Goal;
     let method = a.method.method();
@@ -354,7 +372,7 @@ pub(crate) fn williams_job(a: &SimplifyArgs) -> Result<lodeval::app::WilliamsJob
             }
             s => s,
         },
-        criterion: a.criterion.criterion(),
-        size: a.size,
+        criterion: a.criterion.unwrap_or(CriterionArg::Perceptual).criterion(),
+        size: a.size.unwrap_or(512),
     })
 }

@@ -436,9 +436,20 @@ pub fn write_lod_chain(levels: &[(&str, &Mesh)], coverage: &[f64], path: &Path) 
     }
     let text = serde_json::to_vec(&root)
         .map_err(|e| Error::Internal(format!("glTF export: JSON: {e}")))?;
-    // Side files first, the document last: a failure leaves no document naming missing files.
+    // Nothing written may replace a file any level was read from (an input texture named like
+    // an exported image, `-o` through `missing/..`).
+    let mut planned: Vec<PathBuf> = files_out.iter().map(|(f, _)| f.clone()).collect();
+    planned.push(path.to_path_buf());
+    let inputs: Vec<PathBuf> = levels
+        .iter()
+        .flat_map(|(_, m)| m.source().files.iter().cloned())
+        .collect();
+    crate::io::check_not_inputs(&planned, &inputs)?;
+    // All files land together, the document last: a failure leaves no orphan image and no
+    // document naming missing files.
+    let mut staged = crate::io::Staged::default();
     for (file, bytes) in &files_out {
-        crate::io::write_atomic(file, bytes)?;
+        staged.write(file, bytes)?;
         written.push(file.clone());
     }
     if ext == "glb" {
@@ -454,10 +465,11 @@ pub fn write_lod_chain(levels: &[(&str, &Mesh)], coverage: &[f64], path: &Path) 
         let bytes = glb
             .to_vec()
             .map_err(|e| Error::Internal(format!("glTF export: GLB: {e}")))?;
-        crate::io::write_atomic(path, &bytes)?;
+        staged.write(path, &bytes)?;
     } else {
-        crate::io::write_atomic(path, &text)?;
+        staged.write(path, &text)?;
     }
+    staged.commit()?;
     let mut warnings = node_warnings(finest, &shared);
     warnings.append(&mut materials.warnings);
     Ok(Written {

@@ -82,8 +82,7 @@ fn map_files(m: &Material) -> Vec<MapFile<'_>> {
 pub fn planned_files(mesh: &Mesh, path: &Path) -> Vec<PathBuf> {
     let (stem, dir) = (stem_of(path), crate::io::parent_dir(path));
     let mut files = vec![path.to_path_buf(), dir.join(format!("{stem}.mtl"))];
-    for (i, m) in mesh.materials().iter().enumerate() {
-        let name = safe(&m.name, i);
+    for (m, name) in mesh.materials().iter().zip(material_names(mesh)) {
         for f in map_files(m) {
             files.push(dir.join(format!("{stem}-{name}-{}.{}", f.role, f.extension())));
         }
@@ -159,11 +158,11 @@ fn mtl_entry(m: &Material, name: &str, stem: &str) -> String {
     mtl
 }
 
-/// Write one map file: the kept bytes as they are, or the texels (or one channel) as PNG.
-fn write_map(f: &MapFile, file: &Path) -> Result<()> {
+/// One map file's bytes: the kept bytes as they are, or the texels (or one channel) as PNG.
+fn map_bytes(f: &MapFile, file: &Path) -> Result<Vec<u8>> {
     let t = f.texture;
     if let (None, Some(e)) = (f.channel, t.encoded()) {
-        return crate::io::write_atomic(file, &e.bytes);
+        return Ok(e.bytes.to_vec());
     }
     let img = match f.channel {
         Some(c) => {
@@ -178,7 +177,7 @@ fn write_map(f: &MapFile, file: &Path) -> Result<()> {
                 .ok_or_else(|| crate::Error::Internal("texture size".into()))?,
         ),
     };
-    crate::io::write_image(file, &img)
+    crate::io::encode_image(file, &img)
 }
 
 /// Write `mesh` to `path` (an `.obj`), with its `.mtl` and textures beside it. Refuses (before
@@ -191,14 +190,14 @@ pub fn write(mesh: &Mesh, path: &Path) -> Result<Vec<String>> {
     let dir = crate::io::parent_dir(path);
     let mut mtl = String::new();
     let mut warnings = Vec::new();
-    for (i, m) in mesh.materials().iter().enumerate() {
-        let name = safe(&m.name, i);
-        mtl.push_str(&mtl_entry(m, &name, &stem));
+    // Every file lands together (or none does), the OBJ last.
+    let mut staged = crate::io::Staged::default();
+    let names = material_names(mesh);
+    for (m, name) in mesh.materials().iter().zip(&names) {
+        mtl.push_str(&mtl_entry(m, name, &stem));
         for f in map_files(m) {
-            write_map(
-                &f,
-                &dir.join(format!("{stem}-{name}-{}.{}", f.role, f.extension())),
-            )?;
+            let file = dir.join(format!("{stem}-{name}-{}.{}", f.role, f.extension()));
+            staged.write(&file, &map_bytes(&f, &file)?)?;
         }
         warnings.extend(material_warnings(m));
     }
@@ -230,14 +229,15 @@ pub fn write(mesh: &Mesh, path: &Path) -> Result<Vec<String>> {
             }
         }
     }
-    write_faces(mesh, &mut obj);
-    crate::io::write_atomic(&dir.join(format!("{stem}.mtl")), mtl.as_bytes())?;
-    crate::io::write_atomic(path, obj.as_bytes())?;
+    write_faces(mesh, &names, &mut obj);
+    staged.write(&dir.join(format!("{stem}.mtl")), mtl.as_bytes())?;
+    staged.write(path, obj.as_bytes())?;
+    staged.commit()?;
     Ok(warnings)
 }
 
 /// The `vn`, `vt`, `usemtl` and `f` records.
-fn write_faces(mesh: &Mesh, obj: &mut String) {
+fn write_faces(mesh: &Mesh, names: &[String], obj: &mut String) {
     for n in mesh.normals() {
         let _ = writeln!(obj, "vn {} {} {}", n.x, n.y, n.z);
     }
@@ -250,11 +250,7 @@ fn write_faces(mesh: &Mesh, obj: &mut String) {
     for (t, &m) in mesh.triangles().iter().zip(mesh.material_ids()) {
         if m != current {
             current = m;
-            let _ = writeln!(
-                obj,
-                "usemtl {}",
-                safe(&mesh.materials()[m as usize].name, m as usize)
-            );
+            let _ = writeln!(obj, "usemtl {}", names[m as usize]);
         }
         let [a, b, c] = t.map(|i| i + 1);
         if mesh.uvs().is_some() {
@@ -279,13 +275,26 @@ pub(super) fn file_safe(name: &str) -> String {
         .collect()
 }
 
-fn safe(name: &str, i: usize) -> String {
-    let s = file_safe(name);
-    if s.is_empty() {
-        format!("material{i}")
-    } else {
-        s
+/// Each material's name in the MTL: [`file_safe`], and made unique (`name-2`, …) where two
+/// materials would share one (the same name twice, or `a b` and `a_b`), so no LOD's faces take
+/// another material's maps.
+fn material_names(mesh: &Mesh) -> Vec<String> {
+    let mut used = std::collections::HashSet::new();
+    let mut out = Vec::with_capacity(mesh.materials().len());
+    for (i, m) in mesh.materials().iter().enumerate() {
+        let mut s = file_safe(&m.name);
+        if s.is_empty() {
+            s = format!("material{i}");
+        }
+        let mut name = s.clone();
+        let mut k = 2;
+        while !used.insert(name.to_ascii_lowercase()) {
+            name = format!("{s}-{k}");
+            k += 1;
+        }
+        out.push(name);
     }
+    out
 }
 
 #[cfg(test)]

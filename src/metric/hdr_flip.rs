@@ -139,7 +139,13 @@ pub fn hdr_flip(
         ));
     }
     let exposures = match exposures {
-        Some(e) => e,
+        Some(e) => {
+            let stops = &crate::limits::EXPOSURE_STOPS;
+            for v in [e.start, e.stop] {
+                stops.check("HDR-FLIP exposure", v).map_err(Error::Usage)?;
+            }
+            e
+        }
         None => exposures_for(reference).unwrap_or(Exposures {
             start: 0.0,
             stop: 0.0,
