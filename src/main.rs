@@ -1,5 +1,6 @@
 //! The `lodeval` binary: check the CPU, parse the command line, run it, and map the outcome to an
-//! exit code (0 ok · 1 regression or golden mismatch · 2 bad input or usage · 3 internal error).
+//! exit code (0 ok · 1 regression or golden mismatch · 2 bad input or usage · 3 internal error ·
+//! 130 interrupted by a signal).
 //! Everything else is in `cli/` (the command line) and the library.
 
 mod cli;
@@ -27,6 +28,17 @@ fn main() -> ExitCode {
         return ExitCode::from(e.exit_code());
     }
     let cli = cli::Cli::parse();
+    // SIGINT, SIGTERM, SIGHUP: remove temporaries, lock files and what the run wrote into its
+    // output folder, so nothing half-written looks complete; then exit 130.
+    let _ = ctrlc::set_handler(|| {
+        lodeval::io::interrupted();
+        use std::io::Write as _;
+        let _ = writeln!(
+            std::io::stderr().lock(),
+            "error: interrupted; removed this run's temporary and partial outputs"
+        );
+        std::process::exit(130);
+    });
     std::panic::set_hook(Box::new(|info| {
         if let Ok(mut slot) = PANIC_MESSAGE.lock() {
             *slot = Some(info.to_string());

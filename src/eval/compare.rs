@@ -116,7 +116,7 @@ pub fn compare(job: &CompareJob, progress: &dyn Progress) -> Result<CompareRepor
         backend: job.backend,
         cache: None,
     };
-    let (results, warnings) = evaluate(&plan, &options, progress, None)?;
+    let (results, warnings, _) = evaluate(&plan, &options, progress, None)?;
     let triangles = results
         .lods
         .first()

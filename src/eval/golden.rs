@@ -166,7 +166,7 @@ pub fn run(plan: &Plan, bless: &Bless, ci: bool, out_dir: &Path) -> Result<Golde
     // Mismatch images of an earlier run go first, so what is left is this run's.
     let mut inputs = plan.input_files();
     inputs.push(dir.clone());
-    super::out::prepare(out_dir, super::out::GOLDEN, &inputs)?;
+    let run_dir = super::out::prepare(out_dir, super::out::GOLDEN, &inputs)?;
     let settings = cfg.render.settings();
     let flip = Flip::new(cfg.viewing.viewing().ppd() as f32);
     let mut outcome = GoldenOutcome::default();
@@ -240,6 +240,7 @@ pub fn run(plan: &Plan, bless: &Bless, ci: bool, out_dir: &Path) -> Result<Golde
         super::golden_report::render(&plan.config_path, &outcome)?.as_bytes(),
     )?;
     outcome.report = Some(report);
+    run_dir.seal()?;
     Ok(outcome)
 }
 

@@ -35,6 +35,78 @@ pub(super) struct Manifest {
     /// hostile-input round: such folders are refused by `merge`).
     #[serde(default)]
     pub files: Vec<FileRecord>,
+    /// The content of every file the run's meshes were read from, so that `merge` refuses
+    /// shards that ran on different (or edited) inputs.
+    #[serde(default)]
+    pub inputs: Vec<InputRecord>,
+}
+
+/// One input file of a run.
+#[derive(Debug, Clone, PartialEq, Eq, PartialOrd, Ord, Serialize, Deserialize)]
+pub(super) struct InputRecord {
+    /// As the config names it, relative to the config's folder (`/`-separated).
+    pub path: String,
+    /// SHA-256 of the content, lower-case hex.
+    pub sha256: String,
+}
+
+/// Whether `bytes` is a manifest lodeval wrote (it parses, and names a config and its cases).
+pub(super) fn parses(bytes: &[u8]) -> bool {
+    serde_json::from_slice::<Manifest>(bytes)
+        .is_ok_and(|m| !m.cases.is_empty() && !m.config_text.is_empty())
+}
+
+/// The records of `files` (read bounded), paths relative to `base` where they lie in it; sorted,
+/// one per path.
+pub(super) fn record_inputs(files: &[PathBuf], base: &Path) -> Result<Vec<InputRecord>> {
+    let base = crate::io::target(base);
+    let mut out: Vec<InputRecord> = Vec::new();
+    for f in files {
+        let bytes = crate::io::read_input(f, "input", crate::limits::MESH_BYTES, "check the file")?;
+        let t = crate::io::target(f);
+        let rel = t.strip_prefix(&base).map(Path::to_path_buf).unwrap_or(t);
+        let path: Vec<String> = rel
+            .components()
+            .map(|c| c.as_os_str().to_string_lossy().into_owned())
+            .collect();
+        out.push(InputRecord {
+            path: path.join("/"),
+            sha256: sha256(&bytes),
+        });
+    }
+    out.sort();
+    out.dedup();
+    Ok(out)
+}
+
+/// `Err` when two shards read one input (by its path from the config) with different content.
+pub(super) fn check_same_inputs(
+    a: &Manifest,
+    a_dir: &Path,
+    b: &Manifest,
+    b_dir: &Path,
+) -> Result<()> {
+    for x in &b.inputs {
+        if let Some(y) = a
+            .inputs
+            .iter()
+            .find(|y| y.path == x.path && y.sha256 != x.sha256)
+        {
+            return Err(Error::input(
+                &b_dir.join("shard.json"),
+                format!(
+                    "read {} with other content than {} did (SHA-256 {}… vs {}…): the shards \
+                     ran on different or edited inputs",
+                    y.path,
+                    a_dir.display(),
+                    &x.sha256[..12.min(x.sha256.len())],
+                    &y.sha256[..12.min(y.sha256.len())]
+                ),
+                "rerun every shard on the same inputs, then merge",
+            ));
+        }
+    }
+    Ok(())
 }
 
 /// One file a run wrote.
@@ -212,6 +284,7 @@ mod tests {
             shard: "0/1".into(),
             cases: vec![],
             files,
+            inputs: vec![],
         };
         verify(d, &m).unwrap();
         std::fs::write(d.join("metrics.csv"), "h\na\nb\nb\n").unwrap();

@@ -72,6 +72,7 @@ pub fn eval(
     let plan = Plan::load(config)?;
     gate::check_baseline(&plan)?;
     let out = run::run(plan, options, progress)?;
+    let inputs = manifest::record_inputs(&out.inputs, &io_parent(&out.plan.config_path))?;
     let manifest = Manifest {
         config_path: out.plan.config_path.clone(),
         config_text: out.plan.config_text.clone(),
@@ -83,14 +84,16 @@ pub fn eval(
             .filter(|c| options.shard.contains(c))
             .collect(),
         files: Vec::new(),
+        inputs,
     };
-    let mut outcome = finish(out.plan, out.out_dir, out.results, &manifest)?;
+    let mut outcome = finish(out.plan, out.dir, out.results, &manifest)?;
     outcome.warnings = out.warnings;
     Ok(outcome)
 }
 
 /// Write the tables, gate, JUnit, report and manifest; returns the outcome.
-fn finish(plan: Plan, out_dir: PathBuf, results: Results, manifest: &Manifest) -> Result<Outcome> {
+fn finish(plan: Plan, dir: out::RunDir, results: Results, manifest: &Manifest) -> Result<Outcome> {
+    let out_dir = dir.path().to_path_buf();
     results.write_csvs(&out_dir)?;
     let failures = gate::check(&plan, &results)?;
     crate::io::write_atomic(
@@ -109,6 +112,7 @@ fn finish(plan: Plan, out_dir: PathBuf, results: Results, manifest: &Manifest) -
     let json = serde_json::to_string_pretty(&manifest)
         .map_err(|e| Error::Internal(format!("shard.json: {e}")))?;
     crate::io::write_atomic(&out_dir.join("shard.json"), json.as_bytes())?;
+    dir.seal()?;
     Ok(Outcome {
         out_dir,
         results,
@@ -148,6 +152,7 @@ pub fn merge(dirs: &[PathBuf], out: &Path) -> Result<Outcome> {
     }
     let first = &manifests[0];
     for (m, d) in manifests.iter().zip(dirs).skip(1) {
+        manifest::check_same_inputs(first, &dirs[0], m, d)?;
         if m.config_text != first.config_text {
             return Err(Error::input(
                 &d.join("shard.json"),
@@ -196,6 +201,25 @@ pub fn merge(dirs: &[PathBuf], out: &Path) -> Result<Outcome> {
                 ));
             }
         }
+        // And every case the shard ran has its rows.
+        for c in &m.cases {
+            let has = |a: &String, l: &String| plan::case_id(a, l) == *c;
+            let lods = r.lods.iter().filter(|x| has(&x.asset, &x.lod)).count();
+            if lods != 1 || !r.rows.iter().any(|x| has(&x.asset, &x.lod)) {
+                return Err(Error::input(
+                    &d.join("shard.json"),
+                    format!(
+                        "case {c} has {lods} rows in lods.csv and its metrics rows are {}",
+                        if r.rows.iter().any(|x| has(&x.asset, &x.lod)) {
+                            "there"
+                        } else {
+                            "missing"
+                        }
+                    ),
+                    manifest::FIX,
+                ));
+            }
+        }
         results.rows.extend(r.rows);
         results.lods.extend(r.lods);
         results.distances.extend(r.distances);
@@ -205,13 +229,14 @@ pub fn merge(dirs: &[PathBuf], out: &Path) -> Result<Outcome> {
     for d in dirs {
         if same_or_nested(out, d) {
             return Err(Error::Usage(format!(
-                "--out {} is, holds or lies inside the shard folder {}: the merge would overwrite                  its input; merge into a new folder",
+                "--out {} is, holds or lies inside the shard folder {}: the merge would overwrite \
+                 its input; merge into a new folder",
                 out.display(),
                 d.display()
             )));
         }
     }
-    out::prepare(out, out::EVAL, &[])?;
+    let dir = out::prepare(out, out::EVAL, &[])?;
     for d in dirs {
         for sub in manifest::IMAGE_DIRS {
             copy_tree(&d.join(sub), &out.join(sub))?;
@@ -223,38 +248,26 @@ pub fn merge(dirs: &[PathBuf], out: &Path) -> Result<Outcome> {
         shard: "0/1".into(),
         cases: all,
         files: Vec::new(),
+        inputs: manifests
+            .iter()
+            .flat_map(|m| m.inputs.iter().cloned())
+            .collect::<std::collections::BTreeSet<_>>()
+            .into_iter()
+            .collect(),
     };
-    finish(plan, out.to_path_buf(), results, &manifest)
+    finish(plan, dir, results, &manifest)
 }
 
-/// Whether `a` and `b` are the same folder or one lies inside the other (compared canonically
-/// where they exist; a folder that does not exist yet is compared by its nearest existing
-/// ancestor joined with the rest).
+/// Whether `a` and `b` are the same folder or one lies inside the other ([`crate::io::target`]:
+/// links and `missing/..` do not hide it).
 fn same_or_nested(a: &Path, b: &Path) -> bool {
-    let (a, b) = (canonical(a), canonical(b));
+    let (a, b) = (crate::io::target(a), crate::io::target(b));
     a.starts_with(&b) || b.starts_with(&a)
 }
 
-/// `path` made absolute through its nearest existing ancestor.
-fn canonical(path: &Path) -> PathBuf {
-    let mut rest = Vec::new();
-    let mut p = path.to_path_buf();
-    loop {
-        if let Ok(c) = p.canonicalize() {
-            return rest.into_iter().rev().fold(c, |acc, part| acc.join(part));
-        }
-        match (p.file_name().map(|f| f.to_os_string()), p.parent()) {
-            (Some(f), Some(parent)) => {
-                rest.push(f);
-                p = if parent.as_os_str().is_empty() {
-                    PathBuf::from(".")
-                } else {
-                    parent.to_path_buf()
-                };
-            }
-            _ => return path.to_path_buf(),
-        }
-    }
+/// The folder a config lies in (where its relative paths start).
+fn io_parent(config: &Path) -> PathBuf {
+    crate::io::parent_dir(config)
 }
 
 fn copy_tree(from: &Path, to: &Path) -> Result<()> {

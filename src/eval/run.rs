@@ -59,6 +59,10 @@ pub struct RunOutput {
     pub results: Results,
     /// What the user should know (why `--backend auto` rendered on the CPU).
     pub warnings: Vec<String>,
+    /// Every file the run read its meshes from (meshes, material libraries, textures, buffers).
+    pub inputs: Vec<PathBuf>,
+    /// The output folder, locked until the run is sealed or dropped.
+    pub dir: super::out::RunDir,
 }
 
 /// A LOD ready to render.
@@ -80,13 +84,25 @@ pub fn run(plan: Plan, options: &RunOptions, progress: &dyn Progress) -> Result<
         .config
         .out_dir(&plan.config_path, options.out.as_deref());
     // Before anything is rendered: the folder is lodeval's, and an earlier run's outputs go.
-    super::out::prepare(&out_dir, super::out::EVAL, &plan.input_files())?;
-    let (results, warnings) = evaluate(&plan, options, progress, Some(&out_dir))?;
+    if let Some(cache) = &options.cache
+        && crate::io::within(cache, &out_dir)
+    {
+        return Err(crate::error::Error::Usage(format!(
+            "--cache {} lies inside the output folder {}, which each run clears: keep the \
+             render cache elsewhere",
+            cache.display(),
+            out_dir.display()
+        )));
+    }
+    let dir = super::out::prepare(&out_dir, super::out::EVAL, &plan.input_files())?;
+    let (results, warnings, inputs) = evaluate(&plan, options, progress, Some(&out_dir))?;
     Ok(RunOutput {
         plan,
         out_dir,
         results,
         warnings,
+        inputs,
+        dir,
     })
 }
 
@@ -98,7 +114,7 @@ pub fn evaluate(
     options: &RunOptions,
     progress: &dyn Progress,
     images: Option<&Path>,
-) -> Result<(Results, Vec<String>)> {
+) -> Result<(Results, Vec<String>, Vec<PathBuf>)> {
     let cfg = &plan.config;
     let viewing = cfg.viewing.viewing();
     let scorer = Scorer::new(
@@ -122,8 +138,13 @@ pub fn evaluate(
     progress.start(Some(steps as u64), "renders", "");
     let bar = progress;
     let mut export_warnings = Vec::new();
+    let mut inputs: Vec<PathBuf> = Vec::new();
     let cache = match &options.cache {
-        Some(dir) => Some(super::cache::RenderCache::open(dir)?),
+        Some(dir) => {
+            let (cache, warning) = super::cache::RenderCache::open(dir);
+            export_warnings.extend(warning);
+            cache
+        }
         None => None,
     };
     for asset in &plan.assets {
@@ -137,6 +158,7 @@ pub fn evaluate(
         }
         bar.set_message(&asset.name);
         let original = Arc::new(mesh::load(&asset.mesh, &LoadOptions::default())?);
+        inputs.extend(original.source().files.iter().cloned());
         let reference = scene_for(cfg, original.clone());
         let geometry = (cfg.geometry_samples > 0)
             .then(|| surface_distance::Original::new(&original, cfg.geometry_samples));
@@ -183,7 +205,7 @@ pub fn evaluate(
                 None => {
                     let image = LinearImage::from(&reference_renderer.render(camera, &settings)?);
                     if let (Some(c), Some(k)) = (&cache, &scene_key) {
-                        c.put(k, &settings, camera, &renderer, image.pixels())?;
+                        c.put(k, &settings, camera, &renderer, image.pixels());
                     }
                     image
                 }
@@ -387,7 +409,16 @@ pub fn evaluate(
     results.sort(&plan.case_ids());
     let mut warnings: Vec<String> = engine.fallback().map(str::to_string).into_iter().collect();
     warnings.extend(export_warnings);
-    Ok((results, warnings))
+    warnings.extend(cache.iter().flat_map(|c| c.warnings()));
+    for asset in &plan.assets {
+        inputs.push(asset.mesh.clone()); // also where this shard ran none of its cases
+        for l in &asset.lods {
+            if let super::plan::LodSource::File(p) = &l.source {
+                inputs.push(p.clone());
+            }
+        }
+    }
+    Ok((results, warnings, inputs))
 }
 
 /// A scene of `mesh` with the config's lights, environment, background and ambient term.
