@@ -57,11 +57,11 @@ pub(crate) struct BenchArgs {
     /// (best and median reported); for `optimize`: timed optimizer runs per mesh.
     #[arg(long, default_value_t = 5, value_parser = count::<usize>(&lodeval::limits::RUNS))]
     pub(crate) runs: usize,
-    /// Torus rings (triangles = 2 · rings · sides).
-    #[arg(long, default_value_t = 1000)]
+    /// Torus rings (triangles = 2 · rings · sides), at least 3.
+    #[arg(long, default_value_t = 1000, value_parser = count::<u32>(&lodeval::limits::TORUS_SEGMENTS))]
     pub(crate) rings: u32,
-    /// Torus sides.
-    #[arg(long, default_value_t = 500)]
+    /// Torus sides, at least 3.
+    #[arg(long, default_value_t = 500, value_parser = count::<u32>(&lodeval::limits::TORUS_SEGMENTS))]
     pub(crate) sides: u32,
     /// Image edge in pixels.
     #[arg(long, default_value_t = 1024, value_parser = count::<u32>(&lodeval::limits::IMAGE_SIDE))]

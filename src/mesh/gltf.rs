@@ -43,6 +43,7 @@ struct Builder {
 /// Load a glTF or GLB file.
 pub(crate) fn load(path: &Path, options: &LoadOptions) -> Result<MeshData> {
     let bytes = read_file(path)?;
+    super::gltf_check::check_glb_header(path, &bytes)?;
     let invalid =
         |e: gltf::Error| Error::input(path, format!("not a valid glTF file: {e}"), REEXPORT);
     let gltf::Gltf { document, blob } =
@@ -115,6 +116,7 @@ pub(crate) fn load(path: &Path, options: &LoadOptions) -> Result<MeshData> {
     }
     let mut warnings = std::mem::take(&mut images.warnings);
     let default_id = materials.len() as u32;
+    super::gltf_check::check_tex_coords(path, document.as_json())?;
 
     // Geometry: walk the scene graph, accumulating world transforms.
     let mut b = Builder::default();
@@ -305,6 +307,16 @@ fn add_mesh(
                 prim.mode()
             ));
             continue;
+        }
+        let targets = prim.morph_targets().len();
+        if targets > 0 {
+            b.warnings.push(format!(
+                "mesh {} ('{}') primitive {}: {targets} morph targets are not applied; the \
+                 base shape is drawn and simplified (its default weights ignored)",
+                mesh.index(),
+                crate::error::quote(mesh.name().unwrap_or("")),
+                prim.index()
+            ));
         }
         let reader = prim.reader(|buf| buffers.get(buf.index()).map(|d| &d.0[..]));
         let Some(positions) = reader.read_positions() else {

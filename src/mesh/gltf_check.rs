@@ -17,9 +17,122 @@ use crate::error::{Error, Location, Result};
 
 /// Run every structural check on `root`.
 pub(super) fn check(path: &Path, root: &gltf::json::Root) -> Result<()> {
+    check_version(path, root)?;
     check_nodes(path, root)?;
     check_views(path, root)?;
     check_accessors(path, root)
+}
+
+/// A GLB's header states the file's whole length (glTF 2.0 §4.4.2); one that disagrees with the
+/// bytes is a truncated or spliced file.
+pub(super) fn check_glb_header(path: &Path, bytes: &[u8]) -> Result<()> {
+    if bytes.len() < 12 || &bytes[..4] != b"glTF" {
+        return Ok(()); // JSON glTF, or too short: the parser says so
+    }
+    let version = u32::from_le_bytes([bytes[4], bytes[5], bytes[6], bytes[7]]);
+    let length = u32::from_le_bytes([bytes[8], bytes[9], bytes[10], bytes[11]]) as usize;
+    if version != 2 {
+        return Err(at(
+            path,
+            "GLB header".into(),
+            format!(
+                "not a valid glTF file: the header states container version {version}; lodeval reads GLB version 2"
+            ),
+        ));
+    }
+    if length != bytes.len() {
+        return Err(at(
+            path,
+            "GLB header".into(),
+            format!(
+                "not a valid glTF file: the header states a length of {length} bytes, but the \
+                 file has {}: it is truncated or spliced",
+                bytes.len()
+            ),
+        ));
+    }
+    Ok(())
+}
+
+/// `asset.version` (and `minVersion`) must be a 2.x glTF: a later major version may mean
+/// anything.
+fn check_version(path: &Path, root: &gltf::json::Root) -> Result<()> {
+    let major = |v: &str| v.split('.').next().and_then(|m| m.parse::<u32>().ok());
+    for (key, v) in [
+        ("asset.version", Some(&root.asset.version)),
+        ("asset.minVersion", root.asset.min_version.as_ref()),
+    ] {
+        let Some(v) = v else { continue };
+        if major(v) != Some(2) {
+            return Err(at(
+                path,
+                key.into(),
+                format!("is '{}'; lodeval reads glTF 2.x", crate::error::quote(v)),
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// Every texture a primitive's material reads names a `TEXCOORD_n` set the primitive has (run
+/// once the materials and their images have loaded, so a missing image is named first).
+pub(super) fn check_tex_coords(path: &Path, root: &gltf::json::Root) -> Result<()> {
+    use gltf::json::mesh::Semantic;
+    for (mi, mesh) in root.meshes.iter().enumerate() {
+        for (pi, prim) in mesh.primitives.iter().enumerate() {
+            let Some(m) = prim.material.and_then(|m| root.materials.get(m.value())) else {
+                continue;
+            };
+            let has = |n: u32| {
+                prim.attributes
+                    .keys()
+                    .any(|s| matches!(s, Checked::Valid(Semantic::TexCoords(k)) if *k == n))
+            };
+            let pbr = &m.pbr_metallic_roughness;
+            let slots = [
+                (
+                    "baseColorTexture",
+                    pbr.base_color_texture.as_ref().map(info_set),
+                ),
+                (
+                    "metallicRoughnessTexture",
+                    pbr.metallic_roughness_texture.as_ref().map(info_set),
+                ),
+                (
+                    "normalTexture",
+                    m.normal_texture.as_ref().map(|t| t.tex_coord),
+                ),
+                (
+                    "occlusionTexture",
+                    m.occlusion_texture.as_ref().map(|t| t.tex_coord),
+                ),
+                ("emissiveTexture", m.emissive_texture.as_ref().map(info_set)),
+            ];
+            for (slot, set) in slots {
+                if let Some(n) = set.filter(|&n| !has(n)) {
+                    return Err(at(
+                        path,
+                        format!("mesh {mi} primitive {pi}"),
+                        format!(
+                            "its material {}'s {slot} reads TEXCOORD_{n}, which the primitive \
+                             does not have",
+                            prim.material.map_or(0, |m| m.value())
+                        ),
+                    ));
+                }
+            }
+        }
+    }
+    Ok(())
+}
+
+/// The UV set a texture reads (`KHR_texture_transform` may override it).
+fn info_set(t: &gltf::json::texture::Info) -> u32 {
+    t.extensions
+        .as_ref()
+        .and_then(|e| e.texture_transform.as_ref())
+        .and_then(|x| x.tex_coord)
+        .unwrap_or(t.tex_coord)
 }
 
 fn at(path: &Path, element: String, problem: String) -> Error {

@@ -478,3 +478,51 @@ pub(crate) fn read_file(path: &Path) -> Result<Vec<u8>> {
         "check that it exists and is a readable mesh file",
     )
 }
+
+/// [`read_file`] for a text format (OBJ, OFF): read in pieces, and refused at the first NUL
+/// byte, which no text mesh holds. A binary file, or a sparse one of gigabytes of zeros, is
+/// refused after its first megabyte instead of being read whole.
+pub(crate) fn read_text_file(path: &Path) -> Result<Vec<u8>> {
+    use std::io::Read as _;
+    let fix =
+        "give a text mesh file (this one is binary, or holds zeros: a sparse or damaged file)";
+    let len = crate::io::check_input(path, "mesh", crate::limits::MESH_BYTES, fix)?;
+    let cannot = |e: std::io::Error| Error::input(path, format!("cannot read the mesh: {e}"), fix);
+    let mut file = std::fs::File::open(path).map_err(cannot)?;
+    let mut bytes: Vec<u8> = Vec::with_capacity(len.min(1 << 20) as usize);
+    let mut chunk = vec![0u8; 1 << 20];
+    loop {
+        let n = file.read(&mut chunk).map_err(cannot)?;
+        if n == 0 {
+            break;
+        }
+        if let Some(k) = chunk[..n].iter().position(|&b| b == 0) {
+            let lines = bytes
+                .iter()
+                .chain(&chunk[..k])
+                .filter(|&&b| b == b'\n')
+                .count();
+            return Err(Error::input_at(
+                path,
+                crate::error::Location::Line(lines + 1),
+                format!(
+                    "byte {} is a NUL byte: the file is not text (a text mesh holds none)",
+                    bytes.len() + k
+                ),
+                fix,
+            ));
+        }
+        if (bytes.len() + n) as u64 > crate::limits::MESH_BYTES {
+            return Err(Error::input(
+                path,
+                format!(
+                    "the mesh grew past lodeval's limit of {} bytes while it was read",
+                    crate::limits::MESH_BYTES
+                ),
+                fix,
+            ));
+        }
+        bytes.extend_from_slice(&chunk[..n]);
+    }
+    Ok(bytes)
+}

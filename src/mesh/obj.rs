@@ -22,7 +22,7 @@ use std::path::{Path, PathBuf};
 use glam::{Vec2, Vec3};
 
 use super::texture::{TextureCache, resolve_asset_path};
-use super::{Format, LoadOptions, Material, MeshData, MissingAssets, Source, read_file};
+use super::{Format, LoadOptions, Material, MeshData, MissingAssets, Source};
 use crate::color::srgb_to_linear;
 use crate::error::{Error, Location, Result};
 
@@ -371,7 +371,7 @@ fn missing_asset(
 
 /// Load an OBJ file and the MTL libraries and textures it names.
 pub(crate) fn load(path: &Path, options: &LoadOptions) -> Result<MeshData> {
-    let text = decode(path, read_file(path)?)?;
+    let text = decode(path, super::read_text_file(path)?)?;
     let scan = scan(path, &text)?;
     let dir = path.parent().unwrap_or(Path::new(".")).to_path_buf();
     let mut warnings = Vec::new();
@@ -440,9 +440,12 @@ pub(crate) fn load(path: &Path, options: &LoadOptions) -> Result<MeshData> {
     let tobj_materials = materials.unwrap_or_default();
     // A `usemtl` naming a material no library defines is a missing asset like a missing
     // library: tobj would quietly give those faces the default material.
+    let defined: std::collections::HashSet<&str> =
+        tobj_materials.iter().map(|m| m.name.as_str()).collect();
+    let mut said = std::collections::HashSet::new();
     for (line_no, name) in &scan.usemtls {
-        if tobj_materials.iter().any(|m| &m.name == name) {
-            continue;
+        if defined.contains(name.as_str()) || !said.insert(name.as_str()) {
+            continue; // defined, or the same undefined material used again
         }
         let libraries: Vec<&str> = scan.mtllibs.iter().map(|(_, n)| n.as_str()).collect();
         let problem = if libraries.is_empty() {
@@ -453,9 +456,6 @@ pub(crate) fn load(path: &Path, options: &LoadOptions) -> Result<MeshData> {
                 libraries.join(", ")
             )
         };
-        if warnings.contains(&problem) {
-            continue; // the same undefined material, used again
-        }
         missing_asset(
             options,
             &mut warnings,

@@ -9,7 +9,7 @@ use std::path::Path;
 
 use glam::Vec3;
 
-use super::{Format, MeshData, Source, read_file};
+use super::{Format, MeshData, Source};
 use crate::color::srgb_to_linear;
 use crate::error::{Error, Location, Result};
 
@@ -37,7 +37,7 @@ fn num<T: std::str::FromStr>(path: &Path, line: usize, tok: &str, what: &str) ->
 
 /// Load an OFF file.
 pub(crate) fn load(path: &Path) -> Result<MeshData> {
-    let bytes = read_file(path)?;
+    let bytes = super::read_text_file(path)?;
     let text = String::from_utf8_lossy(&bytes);
     let mut it = lines(&text);
     let truncated = |what: &str| {

@@ -51,9 +51,92 @@ fn index_list(p: &Property) -> Option<Vec<i64>> {
     })
 }
 
+/// The header's promises checked against the bytes before the parser allocates by them: the
+/// format is PLY 1.0, and every element count fits in what the file holds (an ASCII value takes
+/// at least two bytes, a binary one its size), so a header declaring a billion vertices in a
+/// small or sparse file is refused instead of allocating for them.
+fn check_header(path: &Path, bytes: &[u8]) -> Result<()> {
+    let head_len = bytes
+        .windows(10)
+        .take(1 << 16)
+        .position(|w| w == b"end_header")
+        .map(|p| p + 10);
+    let Some(head_len) = head_len else {
+        return Ok(()); // no header within 64 KiB: the parser names the problem
+    };
+    let head = String::from_utf8_lossy(&bytes[..head_len]);
+    let body = (bytes.len() - head_len) as u128;
+    let mut ascii = true;
+    let mut elements: Vec<(String, u128, u128)> = Vec::new(); // name, count, least bytes each
+    for (i, line) in head.lines().enumerate() {
+        let here = Location::Line(i + 1);
+        let words: Vec<&str> = line.split_whitespace().collect();
+        match words.as_slice() {
+            ["format", kind, version, ..] => {
+                if *version != "1.0" {
+                    return Err(Error::input_at(
+                        path,
+                        here,
+                        format!(
+                            "declares PLY version {}; lodeval reads PLY 1.0",
+                            crate::error::quote(version)
+                        ),
+                        REEXPORT,
+                    ));
+                }
+                ascii = *kind == "ascii";
+            }
+            ["element", name, count, ..] => {
+                let n = count.parse::<u128>().unwrap_or(0);
+                elements.push((crate::error::quote(name), n, 0));
+            }
+            ["property", "list", count_type, ..] => {
+                if let Some(e) = elements.last_mut() {
+                    e.2 += if ascii { 2 } else { type_size(count_type) };
+                }
+            }
+            ["property", ty, ..] => {
+                if let Some(e) = elements.last_mut() {
+                    e.2 += if ascii { 2 } else { type_size(ty) };
+                }
+            }
+            _ => {}
+        }
+    }
+    let need: u128 = elements.iter().map(|(_, n, b)| n * b).sum();
+    if need > body {
+        let (name, n, _) = elements
+            .iter()
+            .max_by_key(|(_, n, b)| n * b)
+            .cloned()
+            .unwrap_or_default();
+        return Err(Error::input(
+            path,
+            format!(
+                "the header declares {n} '{name}' elements, but the {body} bytes after it can \
+                 hold far fewer: the file is truncated or its header is wrong"
+            ),
+            REEXPORT,
+        ));
+    }
+    Ok(())
+}
+
+/// Bytes of a PLY scalar type (1 for an unknown name: the parser refuses it).
+fn type_size(ty: &str) -> u128 {
+    match ty {
+        "char" | "uchar" | "int8" | "uint8" => 1,
+        "short" | "ushort" | "int16" | "uint16" => 2,
+        "int" | "uint" | "float" | "int32" | "uint32" | "float32" => 4,
+        "double" | "float64" => 8,
+        _ => 1,
+    }
+}
+
 /// Load a PLY file.
 pub(crate) fn load(path: &Path) -> Result<MeshData> {
     let bytes = read_file(path)?;
+    check_header(path, &bytes)?;
     let parser = Parser::<DefaultElement>::new();
     let ply = parser.read_ply(&mut bytes.as_slice()).map_err(|e| {
         let loc = e.line().map(Location::Line);

@@ -60,6 +60,50 @@ impl std::fmt::Debug for ClosestPoint {
     }
 }
 
+/// obvhs' PLOC builder over `tris`, each box widened by a tiny, deterministic, per-triangle
+/// amount (at most 0.1 % of the triangle's size). PLOC pairs nodes that choose each other by the
+/// area of their union; among equal triangles in a row (a regular grid, a strip of copies) every
+/// cost ties, each node picks the same side, and only one pair merges per pass: the build grows
+/// with the square of the count (100 000 triangles in a row took minutes). Distinct costs break
+/// the ties, so each pass merges a fixed share and the build is n log n again. Wider boxes only
+/// make the search visit a few more nodes; distances are computed on the exact triangles.
+fn build_bvh(tris: &[[Vec3; 3]]) -> Bvh2 {
+    use obvhs::aabb::Aabb;
+    let boxes: Vec<Aabb> = tris
+        .iter()
+        .enumerate()
+        .map(|(i, t)| {
+            let lo = t[0].min(t[1]).min(t[2]);
+            let hi = t[0].max(t[1]).max(t[2]);
+            // SplitMix64 of the index: a fraction in [0, 1) that is the same on every run.
+            let mut z = (i as u64).wrapping_add(0x9E37_79B9_7F4A_7C15);
+            z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+            z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+            let frac = ((z ^ (z >> 31)) >> 40) as f32 / (1u64 << 24) as f32;
+            let size = (hi - lo).max_element().max(f32::MIN_POSITIVE);
+            let pad = Vec3::splat(1e-3 * size * frac);
+            Aabb::new((lo - pad).into(), (hi + pad).into())
+        })
+        .collect();
+    let params = obvhs::BvhBuildParams::medium_build();
+    let mut bvh = obvhs::ploc::PlocBuilder::with_capacity(boxes.len()).build(
+        params.ploc_search_distance,
+        &boxes,
+        (0..boxes.len() as u32).collect::<Vec<_>>(),
+        params.sort_precision,
+        params.search_depth_threshold,
+    );
+    let mut reinsertion = obvhs::bvh2::reinsertion::ReinsertionOptimizer::default();
+    reinsertion.run(&mut bvh, params.reinsertion_batch_ratio, None);
+    obvhs::bvh2::leaf_collapser::collapse(&mut bvh, 2, 1.0);
+    reinsertion.run(
+        &mut bvh,
+        params.reinsertion_batch_ratio * params.post_collapse_reinsertion_batch_ratio_multiplier,
+        None,
+    );
+    bvh
+}
+
 impl ClosestPoint {
     /// Build the tree over `mesh`'s triangles.
     pub fn new(mesh: &Mesh) -> ClosestPoint {
@@ -69,23 +113,7 @@ impl ClosestPoint {
             .iter()
             .map(|t| t.map(|i| p[i as usize]))
             .collect();
-        let obv: Vec<obvhs::triangle::Triangle> = tris
-            .iter()
-            .map(|t| obvhs::triangle::Triangle {
-                v0: t[0].into(),
-                v1: t[1].into(),
-                v2: t[2].into(),
-            })
-            .collect();
-        let bvh = obvhs::bvh2::builder::build_bvh2_from_tris(
-            &obv,
-            obvhs::BvhBuildParams {
-                max_prims_per_leaf: 2,
-                collapse_traversal_cost: 1.0,
-                ..obvhs::BvhBuildParams::medium_build()
-            },
-            &mut std::time::Duration::default(),
-        );
+        let bvh = build_bvh(&tris);
         ClosestPoint { tris, bvh }
     }
 

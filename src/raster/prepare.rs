@@ -123,27 +123,44 @@ impl PreparedMesh {
 }
 
 /// The mip pyramid of `texture`, built once while the texture and a pyramid of it are alive
-/// anywhere in the process. Entries are matched by identity (a live `Weak` to the same `Arc`),
-/// built outside the lock (two threads may both build one: the same pyramid), and dead entries
-/// are dropped on each call.
+/// anywhere in the process. Entries are keyed by the texture's address and confirmed by identity
+/// (a live `Weak` to the same `Arc`, so a reused address is a miss), built outside the lock (two
+/// threads may both build one: the same pyramid). Dead entries are swept when the table has
+/// doubled since the last sweep, so each call costs O(1) amortised (65 536 textures in one mesh
+/// used to make this quadratic).
 fn pyramid(texture: &Arc<Texture>) -> Arc<MipTexture> {
     type Entry = (Weak<Texture>, Weak<MipTexture>);
-    static CACHE: Mutex<Vec<Entry>> = Mutex::new(Vec::new());
-    let find = |cache: &mut Vec<Entry>| {
-        cache.retain(|(t, m)| t.strong_count() > 0 && m.strong_count() > 0);
-        cache
-            .iter()
-            .find(|(t, _)| t.upgrade().is_some_and(|t| Arc::ptr_eq(&t, texture)))
-            .and_then(|(_, m)| m.upgrade())
+    #[derive(Default)]
+    struct Cache {
+        entries: std::collections::HashMap<usize, Entry>,
+        sweep_at: usize,
+    }
+    static CACHE: Mutex<Option<Cache>> = Mutex::new(None);
+    let key = Arc::as_ptr(texture) as usize;
+    let find = |cache: &Cache| {
+        let (t, m) = cache.entries.get(&key)?;
+        t.upgrade()
+            .filter(|t| Arc::ptr_eq(t, texture))
+            .and_then(|_| m.upgrade())
     };
-    if let Some(m) = find(&mut CACHE.lock().unwrap_or_else(|e| e.into_inner())) {
+    let lock = || CACHE.lock().unwrap_or_else(|e| e.into_inner());
+    if let Some(m) = find(lock().get_or_insert_with(Cache::default)) {
         return m;
     }
     let built = Arc::new(MipTexture::build(texture));
-    let mut cache = CACHE.lock().unwrap_or_else(|e| e.into_inner());
-    if let Some(m) = find(&mut cache) {
+    let mut guard = lock();
+    let cache = guard.get_or_insert_with(Cache::default);
+    if let Some(m) = find(cache) {
         return m;
     }
-    cache.push((Arc::downgrade(texture), Arc::downgrade(&built)));
+    cache
+        .entries
+        .insert(key, (Arc::downgrade(texture), Arc::downgrade(&built)));
+    if cache.entries.len() > cache.sweep_at {
+        cache
+            .entries
+            .retain(|_, (t, m)| t.strong_count() > 0 && m.strong_count() > 0);
+        cache.sweep_at = (2 * cache.entries.len()).max(64);
+    }
     built
 }

@@ -8,9 +8,10 @@
 //!   normals, as an engine's LOD built this way shares the vertex buffer. `meshopt-update`: the kept
 //!   vertices get meshoptimizer's new positions and attributes (normals renormalized). Unused
 //!   vertices are dropped afterwards.
-//! - Multi-material meshes are simplified one material at a time, with the vertices that several
-//!   materials share locked, so material borders cannot open cracks. The triangle target is
-//!   shared out in proportion to each material's triangles.
+//! - Multi-material meshes are simplified one material at a time, over that material's own
+//!   vertices, with the vertices that several materials share locked, so material borders cannot
+//!   open cracks. The triangle target is shared out in proportion to each material's triangles;
+//!   an error target stays relative to the whole mesh's extent.
 //! - meshoptimizer detects UV/normal seams itself from coinciding positions, and keeps them.
 //!   Meshes split only by normals go through [`super::chain`]'s welded path first.
 //! - The reported error is meshoptimizer's own estimate, relative to the mesh extent (its
@@ -46,22 +47,26 @@ pub struct Simplified {
 /// stay).
 pub fn simplify(mesh: &Mesh, target: Target) -> Result<Simplified> {
     let positions: Vec<[f32; 3]> = mesh.positions().iter().map(|p| p.to_array()).collect();
-    let (tris, mats, worst_error) = by_material(mesh, target, |indices, locked, count, error| {
+    let extent = ::meshopt::simplify_scale_decoder(&positions);
+    let (tris, mats, worst_error) = by_material(mesh, target, |g| {
+        let local: Vec<[f32; 3]> = match &g.vertices {
+            Some(v) => v.iter().map(|&i| positions[i as usize]).collect(),
+            None => positions.clone(),
+        };
         let mut e = 0f32;
         let r = ::meshopt::simplify_with_locks_decoder(
-            indices,
-            &positions,
-            locked,
-            count,
-            error,
-            ::meshopt::SimplifyOptions::None,
+            &g.indices,
+            &local,
+            &g.locked,
+            g.count,
+            g.error(extent),
+            g.options(),
             Some(&mut e),
         );
-        (r, e)
+        (r, g.relative(e, extent))
     });
     let mut data = mesh.to_data();
     data.normals = Some(mesh.normals().to_vec());
-    let extent = ::meshopt::simplify_scale_decoder(&positions);
     finish(data, tris, mats, worst_error, extent)
 }
 
@@ -95,37 +100,53 @@ pub fn simplify_updating(mesh: &Mesh, target: Target) -> Result<Simplified> {
             attributes.extend(c[v].to_array());
         }
     }
-    // The locks are the same for every material: converted for the first one only.
-    let mut lock: Vec<::meshopt::SimplifyVertex> = Vec::new();
-    let (tris, mats, worst_error) = by_material(mesh, target, |indices, locked, count, error| {
-        if lock.is_empty() {
-            lock = locked
-                .iter()
-                .map(|&l| {
-                    if l {
-                        ::meshopt::SimplifyVertex::Lock
-                    } else {
-                        ::meshopt::SimplifyVertex::None
-                    }
-                })
-                .collect();
-        }
-        let mut r = indices.to_vec();
+    let (tris, mats, worst_error) = by_material(mesh, target, |g| {
+        let ids: Vec<u32> = match &g.vertices {
+            Some(v) => v.clone(),
+            None => (0..positions.len() as u32).collect(),
+        };
+        let mut local_p: Vec<[f32; 3]> = ids.iter().map(|&i| positions[i as usize]).collect();
+        let mut local_a: Vec<f32> = ids
+            .iter()
+            .flat_map(|&i| {
+                attributes[i as usize * k..(i as usize + 1) * k]
+                    .iter()
+                    .copied()
+            })
+            .collect();
+        let lock: Vec<::meshopt::SimplifyVertex> = g
+            .locked
+            .iter()
+            .map(|&l| {
+                if l {
+                    ::meshopt::SimplifyVertex::Lock
+                } else {
+                    ::meshopt::SimplifyVertex::None
+                }
+            })
+            .collect();
+        let mut r = g.indices.clone();
         let mut e = 0f32;
         let n = ::meshopt::simplify_with_update(
             &mut r,
-            &mut positions,
-            &mut attributes,
+            &mut local_p,
+            &mut local_a,
             &weights,
             k * std::mem::size_of::<f32>(),
             Some(&lock),
-            count,
-            error,
-            ::meshopt::SimplifyOptions::None,
+            g.count,
+            g.error(extent),
+            g.options(),
             Some(&mut e),
         );
         r.truncate(n);
-        (r, e)
+        // The group's vertices back into the mesh's arrays (shared ones are locked: unmoved).
+        for (l, &i) in ids.iter().enumerate() {
+            positions[i as usize] = local_p[l];
+            attributes[i as usize * k..(i as usize + 1) * k]
+                .copy_from_slice(&local_a[l * k..(l + 1) * k]);
+        }
+        (r, g.relative(e, extent))
     });
     let mut data = mesh.to_data();
     data.positions = positions.iter().map(|&p| Vec3::from_array(p)).collect();
@@ -177,13 +198,57 @@ fn finish(
     })
 }
 
-/// Simplify `mesh`'s triangles material by material with `one(indices, locked, target index
-/// count, target error) -> (indices, relative error)`; returns the triangles, their material ids
-/// and the largest relative error.
+/// One material's share of a simplification: its triangles over its own vertices.
+struct Group {
+    /// Triangle corners, indexing the group's vertices.
+    indices: Vec<u32>,
+    /// The mesh's ids of the group's vertices, ascending; `None` when the group uses every
+    /// vertex of the mesh (then its indices are the mesh's own).
+    vertices: Option<Vec<u32>>,
+    /// Per group vertex: shared with another material, so it may not move.
+    locked: Vec<bool>,
+    /// Target index count (0: none).
+    count: usize,
+    /// Target error relative to the whole mesh's extent (`f32::MAX`: none).
+    relative_error: f32,
+}
+
+impl Group {
+    /// meshoptimizer's options: a compacted group's error is absolute, so it means the same as
+    /// the whole mesh's relative error whatever the group's own extent.
+    fn options(&self) -> ::meshopt::SimplifyOptions {
+        match self.vertices {
+            Some(_) => ::meshopt::SimplifyOptions::ErrorAbsolute,
+            None => ::meshopt::SimplifyOptions::None,
+        }
+    }
+
+    /// The target error in meshoptimizer's units for these options (`extent`: the whole mesh's).
+    fn error(&self, extent: f32) -> f32 {
+        match self.vertices {
+            Some(_) if self.relative_error < f32::MAX => self.relative_error * extent,
+            _ => self.relative_error,
+        }
+    }
+
+    /// meshoptimizer's result error back to the whole mesh's relative units.
+    fn relative(&self, e: f32, extent: f32) -> f32 {
+        match self.vertices {
+            Some(_) => e / extent.max(f32::MIN_POSITIVE),
+            None => e,
+        }
+    }
+}
+
+/// Simplify `mesh`'s triangles material by material with `one(group) -> (indices into the
+/// group's vertices, error relative to the mesh's extent)`; returns the triangles (mesh vertex
+/// ids), their material ids and the largest relative error. Each material is simplified over its
+/// own vertices only, so the work grows with the mesh, not with materials × vertices (100 000
+/// materials used to take minutes).
 fn by_material(
     mesh: &Mesh,
     target: Target,
-    mut one: impl FnMut(&[u32], &[bool], usize, f32) -> (Vec<u32>, f32),
+    mut one: impl FnMut(&Group) -> (Vec<u32>, f32),
 ) -> (Vec<[u32; 3]>, Vec<u32>, f32) {
     let tris = mesh.triangles();
     let mats = mesh.material_ids();
@@ -192,7 +257,9 @@ fn by_material(
     // Vertices used by more than one material are locked.
     let mut first_material = vec![u32::MAX; vertex_count];
     let mut locked = vec![false; vertex_count];
+    let mut by_mat: Vec<Vec<u32>> = vec![Vec::new(); material_count];
     for (t, &m) in tris.iter().zip(mats) {
+        by_mat[m as usize].extend_from_slice(t);
         for &v in t {
             let f = &mut first_material[v as usize];
             if *f == u32::MAX {
@@ -204,18 +271,13 @@ fn by_material(
     }
     let (mut out_tris, mut out_mats) = (Vec::new(), Vec::new());
     let mut worst_error = 0f32;
-    for m in 0..material_count as u32 {
-        let indices: Vec<u32> = tris
-            .iter()
-            .zip(mats)
-            .filter(|(_, id)| **id == m)
-            .flat_map(|(t, _)| *t)
-            .collect();
+    let mut local_of = vec![u32::MAX; vertex_count];
+    for (m, indices) in by_mat.into_iter().enumerate() {
         if indices.is_empty() {
             continue;
         }
         let group = indices.len() / 3;
-        let (target_count, target_error) = match target {
+        let (count, relative_error) = match target {
             Target::Triangles(n) => {
                 // meshoptimizer asserts (aborts the process) on a target above its input, which
                 // a chained goal can ask for when an earlier LOD stopped short of its own.
@@ -224,11 +286,39 @@ fn by_material(
             }
             Target::Error(e) => (0, e),
         };
-        let (result, error) = one(&indices, &locked, target_count, target_error);
+        let mut ids: Vec<u32> = indices.clone();
+        ids.sort_unstable();
+        ids.dedup();
+        let g = if ids.len() == vertex_count {
+            Group {
+                indices,
+                vertices: None,
+                locked: locked.clone(),
+                count,
+                relative_error,
+            }
+        } else {
+            for (l, &v) in ids.iter().enumerate() {
+                local_of[v as usize] = l as u32;
+            }
+            let g = Group {
+                indices: indices.iter().map(|&v| local_of[v as usize]).collect(),
+                locked: ids.iter().map(|&v| locked[v as usize]).collect(),
+                vertices: Some(ids),
+                count,
+                relative_error,
+            };
+            for &v in g.vertices.iter().flatten() {
+                local_of[v as usize] = u32::MAX;
+            }
+            g
+        };
+        let (result, error) = one(&g);
         worst_error = worst_error.max(error);
         for t in result.chunks_exact(3) {
-            out_tris.push([t[0], t[1], t[2]]);
-            out_mats.push(m);
+            let global = |l: u32| g.vertices.as_ref().map_or(l, |v| v[l as usize]);
+            out_tris.push([global(t[0]), global(t[1]), global(t[2])]);
+            out_mats.push(m as u32);
         }
     }
     (out_tris, out_mats, worst_error)

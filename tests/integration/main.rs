@@ -12,6 +12,10 @@
 //! - `fuzz`: property-based mutation fuzzing of the OBJ, PLY, OFF and GLB paths.
 //! - `hostile`: hostile input by class (`hostile/mod.rs` lists them): refused with exit 2, never
 //!   an abort, a hang or a silently wrong pass.
+//! - `hostile3`: hostile input, round three (`hostile3/mod.rs` lists the classes): inputs
+//!   overwritten through missing folders, writers that never asked, a poisoned render cache,
+//!   shards of different inputs, concurrent and interrupted runs, unbounded work, meaningless
+//!   gates.
 //! - `materials`: glTF materials loaded whole (every slot, sampler, UV set, transform, extension)
 //!   and exported whole by `simplify -o X.glb|.gltf`; MTL PBR keys; what cannot be carried is named.
 //! - `menzel_guthe`: `lodeval simplify --method menzel-guthe` (Menzel & Guthe 2010): goals and
@@ -41,6 +45,7 @@ mod fuzz;
 #[cfg(feature = "gpu")]
 mod gpu;
 mod hostile;
+mod hostile3;
 mod materials;
 mod menzel_guthe;
 mod models;
