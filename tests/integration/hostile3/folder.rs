@@ -19,7 +19,7 @@ fn slow_config(dir: &Path) -> std::path::PathBuf {
         &format!(
             "out = \"out\"\nmetrics = [\"flip\", \"ssim\", \"vdp\"]\n[render]\nsize = 256\n\
              samples = 4\nrig = \"dodecahedron\"\n[distance]\nenabled = false\n[[asset]]\n\
-             name = \"bunny\"\nmesh = \"{}\"\ngenerate = {{ method = \"meshopt\", ratios = [0.5, 0.25, 0.1] }}\n",
+             name = \"bunny\"\nmesh = \"{}\"\ngenerate = {{ method = \"meshopt\", ratios = [0.5, 0.25, 0.1, 0.05, 0.02] }}\n",
             crate::common::model("bunny/stanford-bunny.obj").display()
         ),
     )
