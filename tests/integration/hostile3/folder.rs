@@ -106,8 +106,9 @@ fn sigterm_mid_run_leaves_no_temporary_and_nothing_that_looks_complete() {
     let out = d.join("out");
     let mut child = spawn(&["eval", s(&cfg), "-q"]);
     wait_for("the first heat map", || any_file_under(&out, "heatmaps"));
-    let killed = Command::new("kill")
-        .args(["-TERM", &child.id().to_string()])
+    // Through the shell's builtin `kill` (a `kill` executable may not be installed).
+    let killed = Command::new("sh")
+        .args(["-c", &format!("kill -TERM {}", child.id())])
         .status()
         .unwrap();
     assert!(killed.success());
