@@ -266,34 +266,38 @@ pub struct Seen {
     pub display: crate::metric::vdp::Display,
 }
 
-/// Compare two image files with the given metrics; writes magma heat maps if `options.map` is
-/// given (that path for one metric with a map, `STEM-METRIC.png` beside it for several). With
-/// `options.lenient`, a metric that does not apply to images of this size (SSIM below 11×11, MS-SSIM
-/// below 176×176) is reported without a value and with a note instead of failing the command.
-/// With `options.pixel_threshold`, each per-pixel map also gives the share of pixels above it.
-pub fn diff(
-    engine: &crate::backend::Engine,
+/// Whether `path` names an EXR file (linear, high-dynamic-range): FLIP on two of them is
+/// HDR-FLIP, as NVIDIA's tool decides by the files.
+pub fn is_exr(path: &Path) -> bool {
+    path.extension()
+        .and_then(|e| e.to_str())
+        .is_some_and(|e| e.eq_ignore_ascii_case("exr"))
+}
+
+impl DiffMetric {
+    /// Whether the metric has a per-pixel map (a heat map, `--fail-percent`).
+    pub fn has_map(self) -> bool {
+        matches!(self, DiffMetric::Flip | DiffMetric::Ssim | DiffMetric::Vdp)
+    }
+}
+
+/// What every metric of one comparison shares.
+struct Pair<'a> {
+    engine: &'a crate::backend::Engine,
+    a: crate::metric::LinearImage,
+    b: crate::metric::LinearImage,
+    hdr: bool,
+    ppd: f64,
+    vdp: crate::metric::vdp::Vdp,
+    exposures: Option<crate::metric::hdr_flip::Exposures>,
+}
+
+/// Load two images of the same size, within the memory bound.
+fn load_pair(
     reference: &Path,
     test: &Path,
-    metrics: &[DiffMetric],
-    seen: &Seen,
-    options: &DiffOptions<'_>,
-) -> Result<Vec<DiffResult>> {
-    let DiffOptions {
-        map,
-        lenient,
-        pixel_threshold,
-        exposures,
-    } = *options;
-    // Two EXR files are linear, high-dynamic-range images: FLIP on them is HDR-FLIP, as NVIDIA's
-    // tool decides by the files.
-    let is_exr = |p: &Path| {
-        p.extension()
-            .and_then(|e| e.to_str())
-            .is_some_and(|e| e.eq_ignore_ascii_case("exr"))
-    };
-    let hdr = is_exr(reference) && is_exr(test);
-    use crate::metric::{LinearImage, colormap, flip::Flip, pool, ssim};
+) -> Result<(crate::metric::LinearImage, crate::metric::LinearImage)> {
+    use crate::metric::LinearImage;
     let (a, b) = (LinearImage::load(reference)?, LinearImage::load(test)?);
     if (a.width(), a.height()) != (b.width(), b.height()) {
         return Err(Error::input(
@@ -315,36 +319,51 @@ pub fn diff(
         pixels * crate::limits::BYTES_PER_SCORED_PIXEL,
     )
     .map_err(Error::Usage)?;
-    let viewing = &seen.viewing;
-    let vdp = crate::metric::vdp::Vdp::checked(viewing, seen.display)?;
-    let ppd = viewing.ppd();
-    let (w, h) = (a.width(), a.height());
-    let with_maps = metrics
-        .iter()
-        .filter(|m| matches!(m, DiffMetric::Flip | DiffMetric::Ssim | DiffMetric::Vdp))
-        .count();
+    Ok((a, b))
+}
+
+/// Compare two image files with the given metrics; writes magma heat maps if `options.map` is
+/// given (that path for one metric with a map, `STEM-METRIC.png` beside it for several). With
+/// `options.lenient`, a metric that does not apply to images of this size (SSIM below 11×11, MS-SSIM
+/// below 176×176) is reported without a value and with a note instead of failing the command.
+/// With `options.pixel_threshold`, each per-pixel map also gives the share of pixels above it.
+pub fn diff(
+    engine: &crate::backend::Engine,
+    reference: &Path,
+    test: &Path,
+    metrics: &[DiffMetric],
+    seen: &Seen,
+    options: &DiffOptions<'_>,
+) -> Result<Vec<DiffResult>> {
+    let (a, b) = load_pair(reference, test)?;
+    let pair = Pair {
+        engine,
+        hdr: is_exr(reference) && is_exr(test),
+        ppd: seen.viewing.ppd(),
+        vdp: crate::metric::vdp::Vdp::checked(&seen.viewing, seen.display)?,
+        exposures: options.exposures,
+        a,
+        b,
+    };
+    let with_maps = metrics.iter().filter(|m| m.has_map()).count();
     let map_path = |metric: DiffMetric| -> Option<PathBuf> {
-        let p = map?;
+        let p = options.map.filter(|_| metric.has_map())?;
         if with_maps <= 1 {
             return Some(p.to_path_buf());
         }
         let stem = p.file_stem()?.to_string_lossy();
-        let name = serde_json::to_value(metric).ok()?.as_str()?.to_string();
-        Some(p.with_file_name(format!("{stem}-{name}.png")))
+        Some(p.with_file_name(format!("{stem}-{}.png", metric.name())))
     };
     // No map may replace the images it compares (`--map ref.png`).
-    let maps: Vec<PathBuf> = metrics
-        .iter()
-        .filter(|m| matches!(m, DiffMetric::Flip | DiffMetric::Ssim | DiffMetric::Vdp))
-        .filter_map(|&m| map_path(m))
-        .collect();
+    let maps: Vec<PathBuf> = metrics.iter().filter_map(|&m| map_path(m)).collect();
     crate::io::check_not_inputs(&maps, &[reference.to_path_buf(), test.to_path_buf()])?;
+    let (w, h) = (pair.a.width(), pair.a.height());
     let mut out = Vec::new();
     for &metric in metrics {
         let mut r = DiffResult {
             metric,
             value: None,
-            ppd,
+            ppd: pair.ppd,
             width: w,
             height: h,
             percentiles: None,
@@ -360,116 +379,113 @@ pub fn diff(
             share_over: None,
             exposures: None,
         };
-        // The metric's per-pixel map, larger is worse, where it has one.
-        let mut per_pixel: Option<Vec<f32>> = None;
-        let mut compute = || -> Result<()> {
-            match metric {
-                DiffMetric::Flip => {
-                    let s = if hdr {
-                        let h = crate::metric::hdr_flip::hdr_flip(
-                            &Flip::new(ppd as f32),
-                            &a,
-                            &b,
-                            exposures,
-                        )?;
-                        r.exposures = Some(h.exposures);
-                        r.backend = crate::backend::CPU_RENDERER.to_string();
-                        crate::metric::flip::FlipScore {
-                            mean: h.mean,
-                            map: h.map,
-                        }
-                    } else {
-                        engine.flip(&Flip::new(ppd as f32), &a, &b)?
-                    };
-                    let v = &s.map.values;
-                    let mut p = std::collections::BTreeMap::new();
-                    for q in [25.0, 50.0, 75.0, 95.0, 99.0] {
-                        p.insert(format!("p{q}"), pool::percentile(v, q));
-                    }
-                    // FLIP's weighted percentiles (what NVIDIA's tool reports).
-                    p.insert("weighted_p25".into(), pool::weighted_percentile(v, 0.25));
-                    p.insert("weighted_median".into(), pool::weighted_percentile(v, 0.5));
-                    p.insert("weighted_p75".into(), pool::weighted_percentile(v, 0.75));
-                    p.insert("max".into(), pool::max(v));
-                    r.value = Some(s.mean);
-                    per_pixel = Some(v.clone());
-                    r.percentiles = Some(p);
-                    r.histogram = Some(pool::histogram(v, 20));
-                    if let Some(path) = map_path(metric) {
-                        crate::io::write_image(
-                            &path,
-                            &image::DynamicImage::ImageRgb8(colormap::heat_map(
-                                v,
-                                w,
-                                h,
-                                (h / 32).max(4),
-                            )),
-                        )?;
-                        r.map = Some(path);
-                    }
+        let mut values = None;
+        let scored = score(&pair, &mut r).and_then(|v| {
+            values = v;
+            match (&values, map_path(metric)) {
+                (Some(v), Some(path)) => {
+                    let img = crate::metric::colormap::heat_map(v, w, h, (h / 32).max(4));
+                    crate::io::write_image(&path, &image::DynamicImage::ImageRgb8(img))?;
+                    r.map = Some(path);
+                    Ok(())
                 }
-                DiffMetric::Ssim => {
-                    let (mean, smap) = ssim::ssim(&a, &b, ssim::SsimInput::SrgbLuma)?;
-                    r.value = Some(mean);
-                    let err: Vec<f32> = smap.iter().map(|s| (1.0 - s).clamp(0.0, 1.0)).collect();
-                    per_pixel = Some(err.clone());
-                    if let Some(path) = map_path(metric) {
-                        crate::io::write_image(
-                            &path,
-                            &image::DynamicImage::ImageRgb8(colormap::heat_map(
-                                &err,
-                                w,
-                                h,
-                                (h / 32).max(4),
-                            )),
-                        )?;
-                        r.map = Some(path);
-                    }
-                }
-                DiffMetric::Msssim => {
-                    r.value = Some(ssim::ms_ssim(&a, &b, ssim::SsimInput::SrgbLuma)?)
-                }
-                DiffMetric::Psnr => {
-                    r.value = Some(crate::metric::mse::psnr_srgb8(&a, &b)?);
-                }
-                DiffMetric::PsnrLuminance => r.value = Some(engine.mse(&a, &b)?.psnr_db),
-                DiffMetric::Mse => r.value = Some(engine.mse(&a, &b)?.mse),
-                DiffMetric::Vdp => {
-                    let s = vdp.compare(&a, &b)?;
-                    r.value = Some(s.probability);
-                    r.jnd = Some(s.jnd);
-                    per_pixel = Some(s.map.values.clone());
-                    if let Some(path) = map_path(metric) {
-                        let img = colormap::heat_map(&s.map.values, w, h, (h / 32).max(4));
-                        crate::io::write_image(&path, &image::DynamicImage::ImageRgb8(img))?;
-                        r.map = Some(path);
-                    }
-                }
+                _ => Ok(()),
             }
-            Ok(())
-        };
-        match compute() {
-            Err(Error::Usage(why)) if lenient => r.note = Some(why),
+        });
+        match scored {
+            Err(Error::Usage(why)) if options.lenient => r.note = Some(why),
             other => other?,
         }
-        if let Some(values) = &per_pixel {
-            let mut worst: Option<(usize, f32)> = None;
-            for (i, &v) in values.iter().enumerate() {
-                if worst.is_none_or(|(_, w)| v > w) {
-                    worst = Some((i, v));
-                }
-            }
-            r.worst_pixel = worst.map(|(i, v)| WorstPixel {
-                x: i % w,
-                y: i / w,
-                value: v as f64,
-            });
-            if let Some(t) = pixel_threshold {
-                let over = values.iter().filter(|&&v| v as f64 > t).count();
-                r.share_over = Some(over as f64 / values.len().max(1) as f64);
-            }
+        if let Some(v) = &values {
+            pixel_stats(&mut r, v, options.pixel_threshold);
         }
         out.push(r);
     }
     Ok(out)
+}
+
+/// Score `r.metric` on `pair` into `r`; returns the per-pixel map (larger is worse) where the
+/// metric has one.
+fn score(pair: &Pair<'_>, r: &mut DiffResult) -> Result<Option<Vec<f32>>> {
+    use crate::metric::{flip::Flip, pool, ssim};
+    let (a, b) = (&pair.a, &pair.b);
+    match r.metric {
+        DiffMetric::Flip => {
+            let s = if pair.hdr {
+                let flip = Flip::new(pair.ppd as f32);
+                let h = crate::metric::hdr_flip::hdr_flip(&flip, a, b, pair.exposures)?;
+                r.exposures = Some(h.exposures);
+                r.backend = crate::backend::CPU_RENDERER.to_string();
+                crate::metric::flip::FlipScore {
+                    mean: h.mean,
+                    map: h.map,
+                }
+            } else {
+                pair.engine.flip(&Flip::new(pair.ppd as f32), a, b)?
+            };
+            let v = s.map.values;
+            let mut p = std::collections::BTreeMap::new();
+            for q in [25.0, 50.0, 75.0, 95.0, 99.0] {
+                p.insert(format!("p{q}"), pool::percentile(&v, q));
+            }
+            // FLIP's weighted percentiles (what NVIDIA's tool reports).
+            p.insert("weighted_p25".into(), pool::weighted_percentile(&v, 0.25));
+            p.insert("weighted_median".into(), pool::weighted_percentile(&v, 0.5));
+            p.insert("weighted_p75".into(), pool::weighted_percentile(&v, 0.75));
+            p.insert("max".into(), pool::max(&v));
+            r.value = Some(s.mean);
+            r.percentiles = Some(p);
+            r.histogram = Some(pool::histogram(&v, 20));
+            Ok(Some(v))
+        }
+        DiffMetric::Ssim => {
+            let (mean, smap) = ssim::ssim(a, b, ssim::SsimInput::SrgbLuma)?;
+            r.value = Some(mean);
+            Ok(Some(
+                smap.iter().map(|s| (1.0 - s).clamp(0.0, 1.0)).collect(),
+            ))
+        }
+        DiffMetric::Msssim => {
+            r.value = Some(ssim::ms_ssim(a, b, ssim::SsimInput::SrgbLuma)?);
+            Ok(None)
+        }
+        DiffMetric::Psnr => {
+            r.value = Some(crate::metric::mse::psnr_srgb8(a, b)?);
+            Ok(None)
+        }
+        DiffMetric::PsnrLuminance => {
+            r.value = Some(pair.engine.mse(a, b)?.psnr_db);
+            Ok(None)
+        }
+        DiffMetric::Mse => {
+            r.value = Some(pair.engine.mse(a, b)?.mse);
+            Ok(None)
+        }
+        DiffMetric::Vdp => {
+            let s = pair.vdp.compare(a, b)?;
+            r.value = Some(s.probability);
+            r.jnd = Some(s.jnd);
+            Ok(Some(s.map.values))
+        }
+    }
+}
+
+/// The worst pixel of a per-pixel map and, with a threshold, the share of pixels above it.
+fn pixel_stats(r: &mut DiffResult, values: &[f32], threshold: Option<f64>) {
+    let mut worst: Option<(usize, f32)> = None;
+    for (i, &v) in values.iter().enumerate() {
+        if worst.is_none_or(|(_, w)| v > w) {
+            worst = Some((i, v));
+        }
+    }
+    let w = r.width.max(1);
+    r.worst_pixel = worst.map(|(i, v)| WorstPixel {
+        x: i % w,
+        y: i / w,
+        value: v as f64,
+    });
+    if let Some(t) = threshold {
+        let over = values.iter().filter(|&&v| v as f64 > t).count();
+        r.share_over = Some(over as f64 / values.len().max(1) as f64);
+    }
 }

@@ -191,9 +191,7 @@ pub(crate) fn run(a: DiffArgs) -> Result<(), Error> {
         pixel: a.fail_pixel,
     };
     let gated = metrics[0];
-    if (a.fail_percent.is_some() || a.warn_percent.is_some())
-        && !matches!(gated, DiffMetric::Flip | DiffMetric::Ssim | DiffMetric::Vdp)
-    {
+    if (a.fail_percent.is_some() || a.warn_percent.is_some()) && !gated.has_map() {
         return Err(Error::Usage(format!(
             "--fail-percent and --warn-percent need a per-pixel map: use --metric flip, ssim or \
              vdp, not {}",
@@ -201,11 +199,7 @@ pub(crate) fn run(a: DiffArgs) -> Result<(), Error> {
         )));
     }
     gates.check(gated).map_err(Error::Usage)?;
-    let is_exr = |p: &std::path::Path| {
-        p.extension()
-            .and_then(|e| e.to_str())
-            .is_some_and(|e| e.eq_ignore_ascii_case("exr"))
-    };
+    let is_exr = lodeval::app::is_exr;
     let all_exr = is_exr(&a.reference) && a.test.iter().all(|t| is_exr(t));
     if a.start_exposure.is_some() && !(all_exr && metrics.contains(&DiffMetric::Flip)) {
         warnings(&["--start-exposure, --stop-exposure and --num-exposures apply to HDR-FLIP                     (--metric flip on two EXR images) only; they do nothing here"

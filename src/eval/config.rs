@@ -784,14 +784,8 @@ impl Config {
 
     /// Cross-field checks that serde cannot express.
     fn check(&self, text: &str, path: &Path) -> Result<()> {
-        let at = |needle: &str| {
-            text.find(needle)
-                .map(|i| Location::Line(text[..i].matches('\n').count() + 1))
-        };
-        let fail = |needle: &str, problem: String, fix: &str| match at(needle) {
-            Some(l) => Error::input_at(path, l, problem, fix),
-            None => Error::input(path, problem, fix),
-        };
+        let at = At { text, path };
+        let fail = |needle: &str, problem: String, fix: &str| at.fail(needle, problem, fix);
         if self.assets.is_empty() {
             return Err(Error::input(
                 path,
@@ -806,6 +800,44 @@ impl Config {
                 "name an output folder, e.g. out = \"../results/NAME\", or leave out away",
             ));
         }
+        self.check_viewing(&at)?;
+        self.check_sizes(&at)?;
+        if self.metrics.is_empty() {
+            return Err(fail(
+                "metrics",
+                "metrics is empty".into(),
+                "list at least one of flip, ssim, msssim, psnr, vdp",
+            ));
+        }
+        let mut names = std::collections::BTreeSet::new();
+        for a in &self.assets {
+            let quoted = format!("\"{}\"", a.name.0);
+            if !names.insert(a.name.0.clone()) {
+                return Err(fail(
+                    &quoted,
+                    format!("asset name '{}' is used twice", a.name.0),
+                    "give every [[asset]] its own name",
+                ));
+            }
+            self.check_asset(a, &at)?;
+        }
+        check_thresholds(&self.thresholds)
+            .map_err(|why| fail("[thresholds]", why, THRESHOLD_FIX))?;
+        if let Some(t) = self.gate.tolerance
+            && !(t.is_finite() && t >= 0.0)
+        {
+            return Err(fail(
+                "tolerance",
+                format!("gate.tolerance {t} must be a finite number ≥ 0"),
+                "use e.g. 0.1 for 10 %",
+            ));
+        }
+        Ok(())
+    }
+
+    /// The display model and the viewing geometry describe something real.
+    fn check_viewing(&self, at: &At<'_>) -> Result<()> {
+        let fail = |needle: &str, problem: String, fix: &str| at.fail(needle, problem, fix);
         let v = &self.viewing;
         if let Err(e) = Display::new(
             v.peak_cd_m2.0 as f32,
@@ -826,6 +858,12 @@ impl Config {
                 "describe a real display and viewer, or set ppd (the default display gives 67)",
             ));
         }
+        Ok(())
+    }
+
+    /// Counts within their bounds, and the run's memory and contact sheets within theirs.
+    fn check_sizes(&self, at: &At<'_>) -> Result<()> {
+        let fail = |needle: &str, problem: String, fix: &str| at.fail(needle, problem, fix);
         let counts = [
             (
                 "geometry_samples",
@@ -888,168 +926,39 @@ impl Config {
                 )
             })?;
         }
-        if self.metrics.is_empty() {
+        Ok(())
+    }
+
+    /// One asset: LODs or a generator, a generator that makes sense, unique LOD names, and
+    /// thresholds.
+    fn check_asset(&self, a: &AssetConfig, at: &At<'_>) -> Result<()> {
+        let fail = |needle: &str, problem: String, fix: &str| at.fail(needle, problem, fix);
+        let quoted = format!("\"{}\"", a.name.0);
+        if a.lods.is_empty() && a.generate.is_none() {
             return Err(fail(
-                "metrics",
-                "metrics is empty".into(),
-                "list at least one of flip, ssim, msssim, psnr, vdp",
+                &quoted,
+                format!("asset '{}' has neither lods nor generate", a.name.0),
+                "list LOD files in `lods` or add `generate = { method = \"meshopt\", ratios = [...] }`",
             ));
         }
-        let mut names = std::collections::BTreeSet::new();
-        for a in &self.assets {
-            let quoted = format!("\"{}\"", a.name.0);
-            if !names.insert(a.name.0.clone()) {
+        if let Some(g) = &a.generate {
+            check_generate(a, g, at)?;
+        }
+        let mut lod_names = std::collections::BTreeSet::new();
+        for (name, _) in self.lod_names(a) {
+            if !lod_names.insert(name.clone()) {
                 return Err(fail(
                     &quoted,
-                    format!("asset name '{}' is used twice", a.name.0),
-                    "give every [[asset]] its own name",
+                    format!("asset '{}': LOD name '{name}' is used twice", a.name.0),
+                    "give every LOD its own name",
                 ));
-            }
-            if a.lods.is_empty() && a.generate.is_none() {
-                return Err(fail(
-                    &quoted,
-                    format!("asset '{}' has neither lods nor generate", a.name.0),
-                    "list LOD files in `lods` or add `generate = { method = \"meshopt\", ratios = [...] }`",
-                ));
-            }
-            if let Some(g) = &a.generate {
-                let qu_meyer = g.method == crate::simplify::Method::QuMeyer;
-                let other = !(g.ratios.is_empty() && g.errors.is_empty() && g.distances.is_empty());
-                if qu_meyer == g.vertices.is_empty() || (qu_meyer && other) {
-                    return Err(fail(
-                        &quoted,
-                        format!(
-                            "asset '{}': generate method {} {}",
-                            a.name.0,
-                            g.method.name(),
-                            if qu_meyer {
-                                "remeshes to vertex counts only"
-                            } else {
-                                "takes no vertex counts; those are for qu-meyer"
-                            }
-                        ),
-                        "use `generate = { method = \"qu-meyer\", vertices = [2000, 1000] }` \
-                         for remeshes, ratios or errors for the simplifiers",
-                    ));
-                }
-                if let Some(v) = g.vertices.iter().find(|&&v| v < 4) {
-                    return Err(fail(
-                        &quoted,
-                        format!(
-                            "asset '{}': generate vertices {v}: a remesh needs at least 4",
-                            a.name.0
-                        ),
-                        "give vertex counts of 4 or more",
-                    ));
-                }
-            }
-            if let Some(g) = &a.generate
-                && g.ratios.is_empty()
-                && g.errors.is_empty()
-                && g.distances.is_empty()
-                && g.vertices.is_empty()
-            {
-                return Err(fail(
-                    &quoted,
-                    format!("asset '{}': generate has no ratios and no errors", a.name.0),
-                    "give `ratios = [0.5, 0.25]` and/or `errors = [0.01]` (menzel-guthe also \
-                     takes `distances = [5.0, 10.0]`, metres)",
-                ));
-            }
-            if let Some(g) = &a.generate
-                && !g.distances.is_empty()
-                && g.method != crate::simplify::Method::MenzelGuthe
-            {
-                return Err(fail(
-                    &quoted,
-                    format!(
-                        "asset '{}': generate method {} takes ratios and errors; distances are \
-                         for menzel-guthe",
-                        a.name.0,
-                        g.method.name()
-                    ),
-                    "use ratios or errors, or method = \"menzel-guthe\"",
-                ));
-            }
-            if let Some(g) = &a.generate {
-                // The first pair that does not get coarser: (first, then, what).
-                let pair = |v: Vec<f64>, coarser: fn(f64, f64) -> bool, what: &'static str| {
-                    v.windows(2)
-                        .find(|w| !coarser(w[0], w[1]))
-                        .map(|w| (w[0], w[1], what))
-                };
-                let bad = pair(
-                    g.ratios.iter().map(|r| r.0).collect(),
-                    |a, b| b < a,
-                    "ratios must decrease",
-                )
-                .or(pair(
-                    g.errors.iter().map(|e| e.0).collect(),
-                    |a, b| b > a,
-                    "errors must increase",
-                ))
-                .or(pair(
-                    g.distances.iter().map(|d| d.0).collect(),
-                    |a, b| b > a,
-                    "distances must increase",
-                ))
-                .or(pair(
-                    g.vertices.iter().map(|&v| v as f64).collect(),
-                    |a, b| b < a,
-                    "vertex counts must decrease",
-                ));
-                if let Some((first, then, what)) = bad {
-                    return Err(fail(
-                        &quoted,
-                        format!(
-                            "asset '{}': generate {what} from one LOD to the next ({first} then \
-                             {then}): each LOD of the chain is simplified from the one before",
-                            a.name.0
-                        ),
-                        "order them from the finest LOD to the coarsest, e.g. ratios = [0.5, 0.25]",
-                    ));
-                }
-                let lods = g.ratios.len() + g.errors.len() + g.distances.len() + g.vertices.len();
-                if g.switch_m.len() > lods {
-                    return Err(fail(
-                        &quoted,
-                        format!(
-                            "asset '{}': generate has {} switch_m values for {lods} LODs",
-                            a.name.0,
-                            g.switch_m.len()
-                        ),
-                        "give one switch distance per generated LOD (ratios first, then errors), \
-                         or fewer",
-                    ));
-                }
-            }
-            let mut lod_names = std::collections::BTreeSet::new();
-            for (name, _) in self.lod_names(a) {
-                if !lod_names.insert(name.clone()) {
-                    return Err(fail(
-                        &quoted,
-                        format!("asset '{}': LOD name '{name}' is used twice", a.name.0),
-                        "give every LOD its own name",
-                    ));
-                }
-            }
-            for t in [&a.thresholds]
-                .into_iter()
-                .chain(a.lods.iter().map(|l| &l.thresholds))
-            {
-                check_thresholds(t).map_err(|why| fail(&quoted, why, THRESHOLD_FIX))?;
             }
         }
-        check_thresholds(&self.thresholds)
-            .map_err(|why| fail("[thresholds]", why, THRESHOLD_FIX))?;
-        if let Some(t) = self.gate.tolerance
-            && !(t.is_finite() && t >= 0.0)
+        for t in [&a.thresholds]
+            .into_iter()
+            .chain(a.lods.iter().map(|l| &l.thresholds))
         {
-            return Err(fail(
-                "tolerance",
-                format!("gate.tolerance {t} must be a finite number ≥ 0"),
-                "use e.g. 0.1 for 10 %",
-            ));
+            check_thresholds(t).map_err(|why| fail(&quoted, why, THRESHOLD_FIX))?;
         }
         Ok(())
     }
@@ -1112,6 +1021,136 @@ impl Config {
                 &base,
                 &Path::new("..").join("results").join(stem(config_path)),
             ),
+        }
+    }
+}
+
+/// An asset's `generate`: a method and goals that fit together, each LOD coarser than the last,
+/// at most one switch distance per LOD.
+fn check_generate(a: &AssetConfig, g: &GenerateConfig, at: &At<'_>) -> Result<()> {
+    let fail = |needle: &str, problem: String, fix: &str| at.fail(needle, problem, fix);
+    let quoted = format!("\"{}\"", a.name.0);
+    {
+        let qu_meyer = g.method == crate::simplify::Method::QuMeyer;
+        let other = !(g.ratios.is_empty() && g.errors.is_empty() && g.distances.is_empty());
+        if qu_meyer == g.vertices.is_empty() || (qu_meyer && other) {
+            return Err(fail(
+                &quoted,
+                format!(
+                    "asset '{}': generate method {} {}",
+                    a.name.0,
+                    g.method.name(),
+                    if qu_meyer {
+                        "remeshes to vertex counts only"
+                    } else {
+                        "takes no vertex counts; those are for qu-meyer"
+                    }
+                ),
+                "use `generate = { method = \"qu-meyer\", vertices = [2000, 1000] }` \
+                 for remeshes, ratios or errors for the simplifiers",
+            ));
+        }
+        if let Some(v) = g.vertices.iter().find(|&&v| v < 4) {
+            return Err(fail(
+                &quoted,
+                format!(
+                    "asset '{}': generate vertices {v}: a remesh needs at least 4",
+                    a.name.0
+                ),
+                "give vertex counts of 4 or more",
+            ));
+        }
+    }
+    if g.ratios.is_empty() && g.errors.is_empty() && g.distances.is_empty() && g.vertices.is_empty()
+    {
+        return Err(fail(
+            &quoted,
+            format!("asset '{}': generate has no ratios and no errors", a.name.0),
+            "give `ratios = [0.5, 0.25]` and/or `errors = [0.01]` (menzel-guthe also \
+             takes `distances = [5.0, 10.0]`, metres)",
+        ));
+    }
+    if !g.distances.is_empty() && g.method != crate::simplify::Method::MenzelGuthe {
+        return Err(fail(
+            &quoted,
+            format!(
+                "asset '{}': generate method {} takes ratios and errors; distances are \
+                 for menzel-guthe",
+                a.name.0,
+                g.method.name()
+            ),
+            "use ratios or errors, or method = \"menzel-guthe\"",
+        ));
+    }
+    {
+        // The first pair that does not get coarser: (first, then, what).
+        let pair = |v: Vec<f64>, coarser: fn(f64, f64) -> bool, what: &'static str| {
+            v.windows(2)
+                .find(|w| !coarser(w[0], w[1]))
+                .map(|w| (w[0], w[1], what))
+        };
+        let bad = pair(
+            g.ratios.iter().map(|r| r.0).collect(),
+            |a, b| b < a,
+            "ratios must decrease",
+        )
+        .or(pair(
+            g.errors.iter().map(|e| e.0).collect(),
+            |a, b| b > a,
+            "errors must increase",
+        ))
+        .or(pair(
+            g.distances.iter().map(|d| d.0).collect(),
+            |a, b| b > a,
+            "distances must increase",
+        ))
+        .or(pair(
+            g.vertices.iter().map(|&v| v as f64).collect(),
+            |a, b| b < a,
+            "vertex counts must decrease",
+        ));
+        if let Some((first, then, what)) = bad {
+            return Err(fail(
+                &quoted,
+                format!(
+                    "asset '{}': generate {what} from one LOD to the next ({first} then \
+                     {then}): each LOD of the chain is simplified from the one before",
+                    a.name.0
+                ),
+                "order them from the finest LOD to the coarsest, e.g. ratios = [0.5, 0.25]",
+            ));
+        }
+        let lods = g.ratios.len() + g.errors.len() + g.distances.len() + g.vertices.len();
+        if g.switch_m.len() > lods {
+            return Err(fail(
+                &quoted,
+                format!(
+                    "asset '{}': generate has {} switch_m values for {lods} LODs",
+                    a.name.0,
+                    g.switch_m.len()
+                ),
+                "give one switch distance per generated LOD (ratios first, then errors), \
+                 or fewer",
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// Where a problem of the config text sits: errors at the line where a key first appears.
+struct At<'a> {
+    text: &'a str,
+    path: &'a Path,
+}
+
+impl At<'_> {
+    fn fail(&self, needle: &str, problem: String, fix: &str) -> Error {
+        match self.text.find(needle) {
+            Some(i) => {
+                let line = Location::Line(self.text[..i].matches('\n').count() + 1);
+                Error::input_at(self.path, line, problem, fix)
+            }
+            None => Error::input(self.path, problem, fix),
         }
     }
 }

@@ -378,11 +378,73 @@ pub(crate) fn load(path: &Path, options: &LoadOptions) -> Result<MeshData> {
     if scan.partial_colors {
         warnings.push("vertex colours are given for only some vertices; all were ignored".into());
     }
+    let mtl_paths = libraries(path, &dir, &scan, options, &mut warnings)?;
+    let (models, tobj_materials) = parse(path, &dir, &scan, &mtl_paths)?;
+    check_usemtls(path, &scan, &tobj_materials, options, &mut warnings)?;
+    // Materials and their textures (decoded once, shared).
+    let mut cache = TextureCache::default();
+    let mut out_materials = Vec::with_capacity(tobj_materials.len() + 1);
+    for m in &tobj_materials {
+        let mtl_dir = scan
+            .mtllibs
+            .iter()
+            .filter_map(|(_, n)| mtl_paths.get(n))
+            .find_map(|p| p.parent())
+            .unwrap_or(&dir)
+            .to_path_buf();
+        let ctx = super::mtl::MtlContext {
+            obj: path,
+            dir: &mtl_dir,
+            options,
+        };
+        let mat = super::mtl::material(m, &ctx, &mut cache, &mut warnings)?;
+        out_materials.push(mat);
+    }
+    let g = geometry(&models, out_materials.len());
+    if g.needs_default {
+        out_materials.push(Material::default_material());
+    }
+    let mut files = vec![path.to_path_buf()];
+    files.extend(mtl_paths.into_values().filter(|p| p.is_file()));
+    files.extend(cache.paths());
+    files.sort();
+    files.dedup();
+    Ok(MeshData {
+        positions: g.positions,
+        normals: g.normals,
+        uvs: g.uvs,
+        uvs1: None,
+        colors: g.colors,
+        triangles: g.triangles,
+        material_ids: g.material_ids,
+        materials: out_materials,
+        lights: Vec::new(),
+        source: Source {
+            path: path.to_path_buf(),
+            format: Format::Obj,
+            file_vertices: scan.positions,
+            file_faces: scan.faces,
+            file_unreferenced: scan.unreferenced,
+            edited: false,
+            files,
+            nodes: Vec::new(),
+        },
+        warnings,
+    })
+}
 
-    // Material libraries: a missing one is an error unless the user asked for warnings.
+/// Where each `mtllib` resolves; a missing library is an error unless the user asked for
+/// warnings.
+fn libraries(
+    path: &Path,
+    dir: &Path,
+    scan: &Scan,
+    options: &LoadOptions,
+    warnings: &mut Vec<String>,
+) -> Result<HashMap<String, PathBuf>> {
     let mut mtl_paths: HashMap<String, PathBuf> = HashMap::new();
     for (line_no, name) in &scan.mtllibs {
-        let resolved = resolve_asset_path(&dir, name);
+        let resolved = resolve_asset_path(dir, name);
         if !resolved.exists() {
             let problem = format!(
                 "material library '{name}' not found at {}",
@@ -390,7 +452,7 @@ pub(crate) fn load(path: &Path, options: &LoadOptions) -> Result<MeshData> {
             );
             missing_asset(
                 options,
-                &mut warnings,
+                warnings,
                 (path, *line_no),
                 problem,
                 "put the .mtl file there, fix the mtllib line, or pass --missing-assets warn to use default materials",
@@ -401,7 +463,16 @@ pub(crate) fn load(path: &Path, options: &LoadOptions) -> Result<MeshData> {
         }
         mtl_paths.insert(name.clone(), resolved);
     }
+    Ok(mtl_paths)
+}
 
+/// tobj's models and materials of the scanned text.
+fn parse(
+    path: &Path,
+    dir: &Path,
+    scan: &Scan,
+    mtl_paths: &HashMap<String, PathBuf>,
+) -> Result<(Vec<tobj::Model>, Vec<tobj::Material>)> {
     let load_options = tobj::LoadOptions {
         triangulate: true,
         single_index: false,
@@ -437,7 +508,18 @@ pub(crate) fn load(path: &Path, options: &LoadOptions) -> Result<MeshData> {
             "fix or re-export the .mtl file",
         ));
     }
-    let tobj_materials = materials.unwrap_or_default();
+    Ok((models, materials.unwrap_or_default()))
+}
+
+/// A `usemtl` naming a material no library defines is a missing asset like a missing library:
+/// tobj would quietly give those faces the default material.
+fn check_usemtls(
+    path: &Path,
+    scan: &Scan,
+    tobj_materials: &[tobj::Material],
+    options: &LoadOptions,
+    warnings: &mut Vec<String>,
+) -> Result<()> {
     // A `usemtl` naming a material no library defines is a missing asset like a missing
     // library: tobj would quietly give those faces the default material.
     let defined: std::collections::HashSet<&str> =
@@ -458,7 +540,7 @@ pub(crate) fn load(path: &Path, options: &LoadOptions) -> Result<MeshData> {
         };
         missing_asset(
             options,
-            &mut warnings,
+            warnings,
             (path, *line_no),
             problem,
             "add the material to its .mtl file (newmtl NAME), fix the usemtl line, or pass \
@@ -466,28 +548,24 @@ pub(crate) fn load(path: &Path, options: &LoadOptions) -> Result<MeshData> {
         )?;
     }
 
-    // Materials and their textures (decoded once, shared).
-    let mut cache = TextureCache::default();
-    let mut out_materials = Vec::with_capacity(tobj_materials.len() + 1);
-    for m in &tobj_materials {
-        let mtl_dir = scan
-            .mtllibs
-            .iter()
-            .filter_map(|(_, n)| mtl_paths.get(n))
-            .find_map(|p| p.parent())
-            .unwrap_or(&dir)
-            .to_path_buf();
-        let ctx = super::mtl::MtlContext {
-            obj: path,
-            dir: &mtl_dir,
-            options,
-        };
-        let mat = super::mtl::material(m, &ctx, &mut cache, &mut warnings)?;
-        out_materials.push(mat);
-    }
-    let default_id = out_materials.len() as u32;
-    let mut needs_default = false;
+    Ok(())
+}
 
+/// The welded vertices, triangles and material ids of tobj's models.
+struct Geometry {
+    positions: Vec<Vec3>,
+    normals: Option<Vec<Vec3>>,
+    uvs: Option<Vec<Vec2>>,
+    colors: Option<Vec<Vec3>>,
+    triangles: Vec<[u32; 3]>,
+    material_ids: Vec<u32>,
+    /// Some faces have no (known) material: the default one goes after the file's.
+    needs_default: bool,
+}
+
+fn geometry(models: &[tobj::Model], material_count: usize) -> Geometry {
+    let default_id = material_count as u32;
+    let mut needs_default = false;
     // Vertices: one per distinct (model, position, uv, normal) triple, in order of first use.
     let mut positions = Vec::new();
     let mut uvs = Vec::new();
@@ -500,11 +578,11 @@ pub(crate) fn load(path: &Path, options: &LoadOptions) -> Result<MeshData> {
     let has_c = models.iter().all(|m| !m.mesh.vertex_color.is_empty()) && !models.is_empty();
     let mut triangles = Vec::new();
     let mut material_ids = Vec::new();
-    for model in &models {
+    for model in models {
         let mesh = &model.mesh;
         let mut seen: HashMap<(u32, u32, u32), u32> = HashMap::new();
         let mat = match mesh.material_id {
-            Some(id) if id < out_materials.len() => id as u32,
+            Some(id) if id < material_count => id as u32,
             _ => {
                 needs_default = true;
                 default_id
@@ -555,36 +633,15 @@ pub(crate) fn load(path: &Path, options: &LoadOptions) -> Result<MeshData> {
             material_ids.push(mat);
         }
     }
-    if needs_default {
-        out_materials.push(Material::default_material());
-    }
-    let mut files = vec![path.to_path_buf()];
-    files.extend(mtl_paths.into_values().filter(|p| p.is_file()));
-    files.extend(cache.paths());
-    files.sort();
-    files.dedup();
-    Ok(MeshData {
+    Geometry {
         positions,
         normals: has_n.then_some(normals),
         uvs: has_uv.then_some(uvs),
-        uvs1: None,
         colors: has_c.then_some(colors),
         triangles,
         material_ids,
-        materials: out_materials,
-        lights: Vec::new(),
-        source: Source {
-            path: path.to_path_buf(),
-            format: Format::Obj,
-            file_vertices: scan.positions,
-            file_faces: scan.faces,
-            file_unreferenced: scan.unreferenced,
-            edited: false,
-            files,
-            nodes: Vec::new(),
-        },
-        warnings,
-    })
+        needs_default,
+    }
 }
 
 #[cfg(test)]

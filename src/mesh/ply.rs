@@ -137,8 +137,52 @@ fn type_size(ty: &str) -> u128 {
 pub(crate) fn load(path: &Path) -> Result<MeshData> {
     let bytes = read_file(path)?;
     check_header(path, &bytes)?;
+    let ply = parse(path, &bytes)?;
+    let empty = Vec::new();
+    let vertices = ply.payload.get("vertex").unwrap_or(&empty);
+    if vertices.is_empty() {
+        return Err(Error::input(
+            path,
+            "the file has no 'vertex' element",
+            REEXPORT,
+        ));
+    }
+    let v = read_vertices(path, vertices)?;
+    let n = v.positions.len() as i64;
+    let (mut triangles, mut file_faces) =
+        read_faces(path, ply.payload.get("face").unwrap_or(&empty), n)?;
+    let (strips, strip_faces) =
+        read_strips(path, ply.payload.get("tristrips").unwrap_or(&empty), n)?;
+    triangles.extend(strips);
+    file_faces += strip_faces;
+    Ok(MeshData {
+        positions: v.positions,
+        normals: v.normals,
+        uvs: v.uvs,
+        uvs1: None,
+        colors: v.colors,
+        triangles,
+        material_ids: vec![],
+        materials: vec![],
+        lights: Vec::new(),
+        source: Source {
+            path: path.to_path_buf(),
+            format: Format::Ply,
+            file_vertices: vertices.len(),
+            file_faces,
+            file_unreferenced: 0,
+            edited: false,
+            files: vec![path.to_path_buf()],
+            nodes: Vec::new(),
+        },
+        warnings: vec![],
+    })
+}
+
+/// The parser's reading of `bytes`, its errors as input errors at their line.
+fn parse(path: &Path, bytes: &[u8]) -> Result<ply_rs_bw::ply::Ply<DefaultElement>> {
     let parser = Parser::<DefaultElement>::new();
-    let ply = parser.read_ply(&mut bytes.as_slice()).map_err(|e| {
+    parser.read_ply(&mut &bytes[..]).map_err(|e| {
         let loc = e.line().map(Location::Line);
         // The parser's message starts with its own "Line N: "; we print the line once.
         let text = e.to_string();
@@ -155,19 +199,22 @@ pub(crate) fn load(path: &Path) -> Result<MeshData> {
                 "the file may be truncated; re-export or re-download it",
             ),
         }
-    })?;
-    let empty = Vec::new();
-    let vertices = ply.payload.get("vertex").unwrap_or(&empty);
-    if vertices.is_empty() {
-        return Err(Error::input(
-            path,
-            "the file has no 'vertex' element",
-            REEXPORT,
-        ));
-    }
-    let elem = |what: &str, i: usize| Location::Element(format!("{what} {i}"));
+    })
+}
 
-    // Vertex attributes.
+fn elem(what: &str, i: usize) -> Location {
+    Location::Element(format!("{what} {i}"))
+}
+
+/// The vertex element's attributes (those the first vertex has).
+struct Vertices {
+    positions: Vec<Vec3>,
+    normals: Option<Vec<Vec3>>,
+    colors: Option<Vec<Vec3>>,
+    uvs: Option<Vec<Vec2>>,
+}
+
+fn read_vertices(path: &Path, vertices: &[DefaultElement]) -> Result<Vertices> {
     let first = &vertices[0];
     let has_n = ["nx", "ny", "nz"].iter().all(|k| first.contains_key(*k));
     let color_keys: Option<[&str; 3]> = [
@@ -207,35 +254,48 @@ pub(crate) fn load(path: &Path) -> Result<MeshData> {
             uvs.push(Vec2::new(get(u)?, get(w)?));
         }
     }
+    Ok(Vertices {
+        positions,
+        normals: has_n.then_some(normals),
+        colors: color_keys.map(|_| colors),
+        uvs: uv_keys.map(|_| uvs),
+    })
+}
 
-    // Faces as polygon lists and as triangle strips.
-    let n = positions.len() as i64;
-    let mut triangles = Vec::new();
-    let mut file_faces = 0;
-    let check = |what: &str, i: usize, idx: i64| -> Result<u32> {
-        if idx < 0 || idx >= n {
-            return Err(Error::input_at(
+/// `idx` as a vertex index of `n` vertices, or an error at element `what i`.
+fn vertex_index(path: &Path, what: &str, i: usize, idx: i64, n: i64) -> Result<u32> {
+    if idx < 0 || idx >= n {
+        return Err(Error::input_at(
+            path,
+            elem(what, i),
+            format!("vertex index {idx} is out of range (the file has {n} vertices)"),
+            REEXPORT,
+        ));
+    }
+    Ok(idx as u32)
+}
+
+/// The element's `vertex_indices` list (or `vertex_index`), or an error at element `what i`.
+fn index_list_of(path: &Path, what: &str, i: usize, e: &DefaultElement) -> Result<Vec<i64>> {
+    ["vertex_indices", "vertex_index"]
+        .iter()
+        .find_map(|k| e.get(*k))
+        .and_then(index_list)
+        .ok_or_else(|| {
+            Error::input_at(
                 path,
                 elem(what, i),
-                format!("vertex index {idx} is out of range (the file has {n} vertices)"),
+                "has no 'vertex_indices' list",
                 REEXPORT,
-            ));
-        }
-        Ok(idx as u32)
-    };
-    for (i, f) in ply.payload.get("face").unwrap_or(&empty).iter().enumerate() {
-        let list = ["vertex_indices", "vertex_index"]
-            .iter()
-            .find_map(|k| f.get(*k))
-            .and_then(index_list)
-            .ok_or_else(|| {
-                Error::input_at(
-                    path,
-                    elem("face", i),
-                    "has no 'vertex_indices' list",
-                    REEXPORT,
-                )
-            })?;
+            )
+        })
+}
+
+/// Polygon faces, fanned into triangles; returns them and the face count.
+fn read_faces(path: &Path, faces: &[DefaultElement], n: i64) -> Result<(Vec<[u32; 3]>, usize)> {
+    let mut triangles = Vec::new();
+    for (i, f) in faces.iter().enumerate() {
+        let list = index_list_of(path, "face", i, f)?;
         if list.len() < 3 {
             return Err(Error::input_at(
                 path,
@@ -246,20 +306,19 @@ pub(crate) fn load(path: &Path) -> Result<MeshData> {
         }
         let idx: Vec<u32> = list
             .iter()
-            .map(|&x| check("face", i, x))
+            .map(|&x| vertex_index(path, "face", i, x, n))
             .collect::<Result<_>>()?;
         for k in 1..idx.len() - 1 {
             triangles.push([idx[0], idx[k], idx[k + 1]]);
         }
-        file_faces += 1;
     }
-    for (i, s) in ply
-        .payload
-        .get("tristrips")
-        .unwrap_or(&empty)
-        .iter()
-        .enumerate()
-    {
+    Ok((triangles, faces.len()))
+}
+
+/// Triangle strips (−1 restarts a strip); returns the non-degenerate triangles and their count.
+fn read_strips(path: &Path, strips: &[DefaultElement], n: i64) -> Result<(Vec<[u32; 3]>, usize)> {
+    let mut triangles = Vec::new();
+    for (i, s) in strips.iter().enumerate() {
         let list = s
             .get("vertex_indices")
             .and_then(index_list)
@@ -274,7 +333,7 @@ pub(crate) fn load(path: &Path) -> Result<MeshData> {
         for strip in list.split(|&x| x == -1) {
             let idx: Vec<u32> = strip
                 .iter()
-                .map(|&x| check("tristrips", i, x))
+                .map(|&x| vertex_index(path, "tristrips", i, x, n))
                 .collect::<Result<_>>()?;
             for k in 0..idx.len().saturating_sub(2) {
                 let t = if k % 2 == 0 {
@@ -284,32 +343,10 @@ pub(crate) fn load(path: &Path) -> Result<MeshData> {
                 };
                 if t[0] != t[1] && t[1] != t[2] && t[0] != t[2] {
                     triangles.push(t);
-                    file_faces += 1;
                 }
             }
         }
     }
-
-    Ok(MeshData {
-        positions,
-        normals: has_n.then_some(normals),
-        uvs: uv_keys.map(|_| uvs),
-        uvs1: None,
-        colors: color_keys.map(|_| colors),
-        triangles,
-        material_ids: vec![],
-        materials: vec![],
-        lights: Vec::new(),
-        source: Source {
-            path: path.to_path_buf(),
-            format: Format::Ply,
-            file_vertices: vertices.len(),
-            file_faces,
-            file_unreferenced: 0,
-            edited: false,
-            files: vec![path.to_path_buf()],
-            nodes: Vec::new(),
-        },
-        warnings: vec![],
-    })
+    let count = triangles.len();
+    Ok((triangles, count))
 }
