@@ -204,11 +204,9 @@ impl RenderCache {
         renderer: &str,
         color: &[Vec3],
     ) {
-        let Ok(mut unwritable) = self.unwritable.lock() else {
-            return;
-        };
-        if unwritable.is_some() {
-            return;
+        match self.unwritable.lock() {
+            Ok(u) if u.is_none() => {}
+            _ => return, // an earlier write failed: said once, not tried again
         }
         let (key, path) = self.key(scene, settings, camera, renderer);
         let mut pixels = Vec::with_capacity(color.len() * 12);
@@ -224,8 +222,11 @@ impl RenderCache {
         bytes.extend_from_slice(&pixels);
         // A link planted where the entry goes is replaced, never written through.
         let _ = std::fs::remove_file(&path);
-        if let Err(e) = crate::io::write_atomic(&path, &bytes) {
-            *unwritable = Some(e.to_string());
+        // The lock is not held while writing: threads store their frames side by side.
+        if let Err(e) = crate::io::write_atomic(&path, &bytes)
+            && let Ok(mut u) = self.unwritable.lock()
+        {
+            u.get_or_insert(e.to_string());
         }
     }
 }

@@ -23,9 +23,10 @@ fn live() -> std::sync::MutexGuard<'static, BTreeSet<PathBuf>> {
 }
 
 /// Files committed into an owned folder (absolute, by [`super::target`]), and the owned folders.
-static WRITTEN: Mutex<(Vec<PathBuf>, Vec<PathBuf>)> = Mutex::new((Vec::new(), Vec::new()));
+static WRITTEN: Mutex<(BTreeSet<PathBuf>, Vec<PathBuf>)> =
+    Mutex::new((BTreeSet::new(), Vec::new()));
 
-fn written() -> std::sync::MutexGuard<'static, (Vec<PathBuf>, Vec<PathBuf>)> {
+fn written() -> std::sync::MutexGuard<'static, (BTreeSet<PathBuf>, Vec<PathBuf>)> {
     WRITTEN.lock().unwrap_or_else(|p| p.into_inner())
 }
 
@@ -59,7 +60,7 @@ pub fn disown(root: &Path) {
     w.0.retain(|f| !f.starts_with(&root));
 }
 
-/// The files this process wrote inside `root` since [`own`], in the order written.
+/// The files this process wrote inside `root` since [`own`], in path order.
 pub fn written_under(root: &Path) -> Vec<PathBuf> {
     let root = super::target(root);
     written()
@@ -142,8 +143,8 @@ impl Staged {
             live().remove(tmp);
             let dest = super::target(dest);
             let mut w = written();
-            if w.1.iter().any(|r| dest.starts_with(r)) && !w.0.contains(&dest) {
-                w.0.push(dest);
+            if w.1.iter().any(|r| dest.starts_with(r)) {
+                w.0.insert(dest);
             }
         }
         Ok(())
