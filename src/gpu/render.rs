@@ -372,7 +372,6 @@ impl GpuScene {
             };
         }
         let settings = &settings;
-        let pipelines = gpu.render_pipelines();
         let (w, h) = (settings.width, settings.height);
         let limits = gpu.device.limits();
         let offsets = settings.samples.offsets();
@@ -387,6 +386,25 @@ impl GpuScene {
                 limits.max_texture_dimension_2d, limits.max_texture_array_layers
             )));
         }
+        let globals = self.globals(camera, settings, &offsets);
+        let mvp = gpu.uniform(
+            "visibility globals",
+            bytemuck::bytes_of(&Mvp { mvp: globals.mvp }),
+        );
+        let globals = gpu.uniform("shading globals", bytemuck::bytes_of(&globals));
+        let ids = sample_target(gpu, "triangle ids", ID_FORMAT, w, h, samples);
+        let depth = sample_target(gpu, "depth", DEPTH_FORMAT, w, h, samples);
+        let mut encoder = gpu.encoder();
+        self.visibility_passes(&mut encoder, settings, &offsets, &mvp, &ids, &depth);
+        self.shade_and_read(encoder, &globals, &ids, &depth, (w, h))
+    }
+
+    /// The shading pass's uniforms for `camera`: matrices, lights of both models, sample
+    /// offsets, the environment and the display transform.
+    fn globals(&self, camera: &Camera, settings: &RenderSettings, offsets: &[[i64; 2]]) -> Globals {
+        let (w, h) = (settings.width, settings.height);
+        let samples = offsets.len() as u32;
+        let to_px = |o: i64| o as f32 / 256.0;
         let (mvp, (near, far, perspective)) = camera_setup(camera, w, h);
         let mut lights = [GpuLight::zeroed(); MAX_LIGHTS];
         let resolved = ResolvedLight::for_camera(&self.lights[0], camera);
@@ -397,9 +415,8 @@ impl GpuScene {
                 h: l.h.extend(0.0).to_array(),
             };
         }
-        let to_px = |o: i64| o as f32 / 256.0;
         let mut sample_offsets = [[0.0f32; 4]; MAX_SAMPLES];
-        for (out, o) in sample_offsets.iter_mut().zip(&offsets) {
+        for (out, o) in sample_offsets.iter_mut().zip(offsets) {
             *out = [to_px(o[0]), to_px(o[1]), 0.0, 0.0];
         }
         let mut plights = [GpuPbrLight::zeroed(); MAX_LIGHTS];
@@ -413,7 +430,7 @@ impl GpuScene {
             crate::scene::Projection::Perspective { .. }
         );
         let rows = self.to_map.transpose();
-        let globals = Globals {
+        Globals {
             mvp: mvp.to_cols_array_2d(),
             lights,
             offsets: sample_offsets,
@@ -454,34 +471,23 @@ impl GpuScene {
                     ToneMapping::PbrNeutral => 2,
                 },
             ],
-        };
-        let globals = gpu.uniform("shading globals", bytemuck::bytes_of(&globals));
-        let mvp = gpu.uniform(
-            "visibility globals",
-            bytemuck::bytes_of(&Mvp {
-                mvp: mvp.to_cols_array_2d(),
-            }),
-        );
+        }
+    }
 
-        let target = |label: &str, format: wgpu::TextureFormat| {
-            gpu.device.create_texture(&wgpu::TextureDescriptor {
-                label: Some(label),
-                size: wgpu::Extent3d {
-                    width: w,
-                    height: h,
-                    depth_or_array_layers: samples,
-                },
-                mip_level_count: 1,
-                sample_count: 1,
-                dimension: wgpu::TextureDimension::D2,
-                format,
-                usage: wgpu::TextureUsages::RENDER_ATTACHMENT
-                    | wgpu::TextureUsages::TEXTURE_BINDING,
-                view_formats: &[],
-            })
-        };
-        let ids = target("triangle ids", ID_FORMAT);
-        let depth = target("depth", DEPTH_FORMAT);
+    /// Stage 1: one visibility pass per sample, into layer k of `ids` and `depth`.
+    fn visibility_passes(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        settings: &RenderSettings,
+        offsets: &[[i64; 2]],
+        mvp: &wgpu::Buffer,
+        ids: &wgpu::Texture,
+        depth: &wgpu::Texture,
+    ) {
+        let gpu = &self.gpu;
+        let pipelines = gpu.render_pipelines();
+        let (w, h) = (settings.width, settings.height);
+        let to_px = |o: i64| o as f32 / 256.0;
         let layer = |t: &wgpu::Texture, k: u32| {
             t.create_view(&wgpu::TextureViewDescriptor {
                 dimension: Some(wgpu::TextureViewDimension::D2),
@@ -495,8 +501,6 @@ impl GpuScene {
         } else {
             &pipelines.visibility
         };
-        let mut encoder = gpu.encoder();
-        // Stage 1: one visibility pass per sample.
         for (k, o) in offsets.iter().enumerate() {
             // Move sample (ox, oy) of every pixel onto the pixel centre.
             let shift = |o: i64| 0.5 - to_px(o);
@@ -508,18 +512,14 @@ impl GpuScene {
             let bind = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
                 label: Some("visibility"),
                 layout: &visibility.get_bind_group_layout(0),
-                entries: &[
-                    (0, &mvp),
-                    (1, &self.vertices),
-                    (2, &self.tris),
-                    (3, &jitter),
-                ]
-                .map(|(binding, b)| wgpu::BindGroupEntry {
-                    binding,
-                    resource: b.as_entire_binding(),
-                }),
+                entries: &[(0, mvp), (1, &self.vertices), (2, &self.tris), (3, &jitter)].map(
+                    |(binding, b)| wgpu::BindGroupEntry {
+                        binding,
+                        resource: b.as_entire_binding(),
+                    },
+                ),
             });
-            let (id_view, depth_view) = (layer(&ids, k as u32), layer(&depth, k as u32));
+            let (id_view, depth_view) = (layer(ids, k as u32), layer(depth, k as u32));
             let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
                 label: Some("visibility"),
                 color_attachments: &[Some(wgpu::RenderPassColorAttachment {
@@ -550,7 +550,19 @@ impl GpuScene {
             pass.set_bind_group(0, &bind, &[]);
             pass.draw(0..self.triangle_count * 3, 0..1);
         }
-        // Stage 2: shade and resolve.
+    }
+
+    /// Stage 2: shade and resolve every pixel from the sample layers, and read the frame back.
+    fn shade_and_read(
+        &self,
+        mut encoder: wgpu::CommandEncoder,
+        globals: &wgpu::Buffer,
+        ids: &wgpu::Texture,
+        depth: &wgpu::Texture,
+        (w, h): (u32, u32),
+    ) -> Result<Frame> {
+        let gpu = &self.gpu;
+        let pipelines = gpu.render_pipelines();
         let n = (w * h) as u64;
         let out_color = gpu.output("resolved colour", n * 16);
         let out_aux = gpu.output("resolved depth and id", n * 8);
@@ -560,7 +572,7 @@ impl GpuScene {
                 ..Default::default()
             })
         };
-        let (ids_all, depth_all) = (array(&ids), array(&depth));
+        let (ids_all, depth_all) = (array(ids), array(depth));
         let mut resources = vec![
             globals.as_entire_binding(),
             self.vertices.as_entire_binding(),
@@ -597,6 +609,31 @@ impl GpuScene {
             triangle: aux[..n].iter().map(|a| a[1]).collect(),
         })
     }
+}
+
+/// A render target of `samples` layers at `w` × `h`.
+fn sample_target(
+    gpu: &Gpu,
+    label: &str,
+    format: wgpu::TextureFormat,
+    w: u32,
+    h: u32,
+    samples: u32,
+) -> wgpu::Texture {
+    gpu.device.create_texture(&wgpu::TextureDescriptor {
+        label: Some(label),
+        size: wgpu::Extent3d {
+            width: w,
+            height: h,
+            depth_or_array_layers: samples,
+        },
+        mip_level_count: 1,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D2,
+        format,
+        usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
+        view_formats: &[],
+    })
 }
 
 /// The visibility pipelines and the shading pipeline.
