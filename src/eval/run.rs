@@ -72,8 +72,14 @@ struct LodScene {
     info: LodInfo,
 }
 
+/// One view's contact-sheet tiles: original, LOD, heat map.
+type Tiles = [image::RgbImage; 3];
+
+/// One LOD scored from one view: (metric, value) pairs and its sheet tiles.
+type LodOfView = (Vec<(&'static str, f64)>, Option<Tiles>);
+
 /// Thumbnails kept for one LOD's contact sheet: per view (original, LOD, heat map).
-type SheetViews = Vec<(usize, [image::RgbImage; 3])>;
+type SheetViews = Vec<(usize, Tiles)>;
 
 const THUMB: u32 = 256;
 
@@ -137,16 +143,20 @@ pub fn evaluate(
     let steps = cases * (views + usize::from(cfg.distance.enabled));
     progress.start(Some(steps as u64), "renders", "");
     let bar = progress;
+    let shared = Shared {
+        cfg,
+        settings: &settings,
+        scorer: &scorer,
+        images,
+        bar,
+    };
     let mut export_warnings = Vec::new();
     let mut inputs: Vec<PathBuf> = Vec::new();
-    let cache = match &options.cache {
-        Some(dir) => {
-            let (cache, warning) = super::cache::RenderCache::open(dir);
-            export_warnings.extend(warning);
-            cache
-        }
-        None => None,
-    };
+    let (cache, warning) = options
+        .cache
+        .as_deref()
+        .map_or((None, None), super::cache::RenderCache::open);
+    export_warnings.extend(warning);
     for asset in &plan.assets {
         let wanted: Vec<bool> = asset
             .lods
@@ -160,26 +170,7 @@ pub fn evaluate(
         let original = Arc::new(mesh::load(&asset.mesh, &LoadOptions::default())?);
         inputs.extend(original.source().files.iter().cloned());
         let reference = scene_for(cfg, original.clone());
-        let geometry = (cfg.geometry_samples > 0)
-            .then(|| surface_distance::Original::new(&original, cfg.geometry_samples));
-        let lods = build_lods(asset, &original, &wanted)?
-            .into_iter()
-            .map(|(name, mesh, mut info)| {
-                if let Some(g) = &geometry {
-                    let d = g.compare(&mesh);
-                    info.hausdorff = Some(round7(d.hausdorff));
-                    info.mean_distance = Some(round7(d.mean));
-                    info.rms_distance = Some(round7(d.rms));
-                    info.hausdorff_relative = Some(round7(d.hausdorff_relative));
-                    info.mean_relative = Some(round7(d.mean_relative));
-                }
-                LodScene {
-                    name,
-                    scene: scene_for(cfg, Arc::new(mesh)),
-                    info,
-                }
-            })
-            .collect::<Vec<_>>();
+        let lods = lod_scenes(cfg, asset, &original, &wanted)?;
         let cameras = cfg.render.rig.0.cameras(&original, 1.0);
         let reference_renderer = engine.scene(&reference)?;
         let scene_key = match &cache {
@@ -190,217 +181,42 @@ pub fn evaluate(
             .iter()
             .map(|l| engine.scene(&l.scene))
             .collect::<Result<Vec<_>>>()?;
-        let mut sheets: Vec<SheetViews> = vec![Vec::new(); lods.len()];
-        // The original's frame of view v, prepared for scoring, and its thumbnail.
-        let reference_view = |v: usize| -> Result<_> {
-            let camera = &cameras[v];
-            // The original's colour, from the cache where it holds this very frame.
-            let cached = cache
-                .as_ref()
-                .zip(scene_key.as_ref())
-                .and_then(|(c, k)| c.get(k, &settings, camera, &renderer));
-            let reference_image = match cached {
-                Some(px) => LinearImage::new(settings.width as usize, settings.height as usize, px)
-                    .ok_or_else(|| crate::error::Error::Internal("render cache: size".into()))?,
-                None => {
-                    let image = LinearImage::from(&reference_renderer.render(camera, &settings)?);
-                    if let (Some(c), Some(k)) = (&cache, &scene_key) {
-                        c.put(k, &settings, camera, &renderer, image.pixels());
-                    }
-                    image
-                }
-            };
-            let prepared = scorer.prepare(reference_image);
-            let ref_thumb = thumbnail(&prepared.srgb8());
-            Ok((prepared, ref_thumb))
-        };
-        let mut next = (!cameras.is_empty()).then(|| reference_view(0));
-        for (v, camera) in cameras.iter().enumerate() {
-            let (prepared, ref_thumb) = next.take().expect("prepared ahead")?;
-            // One LOD of this view: rendered, scored, its heat maps written, its sheet tiles.
-            let score_lod = |(lod, lod_renderer): (&LodScene, &SceneRenderer)| -> Result<_> {
-                let test_frame = lod_renderer.render(camera, &settings)?;
-                let scored = scorer.score(&prepared, &LinearImage::from(&test_frame))?;
-                if let Some(out_dir) = images
-                    && cfg.images.heatmaps == HeatmapChoice::All
-                {
-                    for (metric, map) in &scored.maps {
-                        write_heat_map(out_dir, &asset.name, &lod.name, v, metric, map)?;
-                    }
-                }
-                let thumbs = scored.maps.first().map(|(metric, map)| {
-                    let test_rgb8: Cow<image::RgbImage> = match &scored.srgb8 {
-                        Some(rgb) => Cow::Borrowed(rgb),
-                        None => Cow::Owned(test_frame.to_srgb8()),
-                    };
-                    let heat = colormap::heat_map(&map.values, map.width, map.height, 0);
-                    let score = scored
-                        .values
-                        .iter()
-                        .find(|(m, _)| m == metric)
-                        .map_or(String::new(), |(_, x)| format!(" {x:.4}"));
-                    [
-                        captioned(ref_thumb.clone(), &format!("view {v} · original")),
-                        captioned(thumbnail(&test_rgb8), &format!("view {v} · {}", lod.name)),
-                        captioned(
-                            thumbnail(&heat),
-                            &format!("{}{score}", metric.to_uppercase()),
-                        ),
-                    ]
-                });
-                bar.advance(1);
-                Ok((scored.values, thumbs))
-            };
-            // The LODs of one view are independent: render and score them in parallel, then
-            // record them in LOD order (outputs never depend on which finished first). The next
-            // view's original is prepared meanwhile, so that no core waits for it.
-            let (per_lod, following) = rayon::join(
-                || {
-                    lods.par_iter()
-                        .zip(&lod_renderers)
-                        .map(score_lod)
-                        .collect::<Result<Vec<_>>>()
-                },
-                || (v + 1 < cameras.len()).then(|| reference_view(v + 1)),
-            );
-            let per_lod = per_lod?;
-            next = following;
-            for (k, (lod, (values, thumbs))) in lods.iter().zip(per_lod).enumerate() {
-                for (metric, value) in values {
-                    results.rows.push(MetricRow {
-                        asset: asset.name.clone(),
-                        lod: lod.name.clone(),
-                        triangles: lod.info.triangles,
-                        view: v,
-                        metric: metric.to_string(),
-                        value,
-                        renderer: renderer.clone(),
-                    });
-                }
-                if let Some(t) = thumbs {
-                    sheets[k].push((v, t));
-                }
-            }
-        }
+        let cached = cache.as_ref().zip(scene_key.as_ref());
+        let original_view =
+            |v: usize| reference_view(&shared, &renderer, cached, &reference_renderer, &cameras[v]);
+        let sheets = score_views(
+            &shared,
+            &asset.name,
+            &cameras,
+            (&lods, &lod_renderers),
+            original_view,
+            &renderer,
+            &mut results,
+        )?;
         let orders: Vec<Vec<usize>> = lods
             .iter()
             .map(|lod| worst_first(&results, &asset.name, &lod.name, &cfg.metrics))
             .collect();
         // Heat maps and sheets beside the distance searches: both only read what is done.
-        let write_images = || -> Result<()> {
-            if let Some(out_dir) = images
-                && cfg.images.heatmaps == HeatmapChoice::Worst
-            {
-                // Re-render the worst view only, for its heat maps: each distinct worst view's
-                // original once, its LODs in parallel.
-                let mut worst: Vec<usize> =
-                    orders.iter().filter_map(|o| o.first().copied()).collect();
-                worst.sort_unstable();
-                worst.dedup();
-                for view in worst {
-                    let camera = &cameras[view];
-                    let a = LinearImage::from(&reference_renderer.render(camera, &settings)?);
-                    let reference = scorer.prepare(a);
-                    lods.par_iter()
-                        .zip(&lod_renderers)
-                        .zip(&orders)
-                        .filter(|(_, order)| order.first() == Some(&view))
-                        .map(|((lod, lod_renderer), _)| -> Result<()> {
-                            let b = LinearImage::from(&lod_renderer.render(camera, &settings)?);
-                            let scored = scorer.score(&reference, &b)?;
-                            for (metric, map) in &scored.maps {
-                                write_heat_map(out_dir, &asset.name, &lod.name, view, metric, map)?;
-                            }
-                            Ok(())
-                        })
-                        .collect::<Result<()>>()?;
-                }
-            }
-            if let Some(out_dir) = images
-                && cfg.images.contact_sheets
-            {
-                lods.par_iter()
-                    .zip(&sheets)
-                    .zip(&orders)
-                    .filter(|((_, sheet), _)| !sheet.is_empty())
-                    .map(|((lod, sheet), order)| -> Result<()> {
-                        let mut tiles = Vec::new();
-                        for &v in order.iter().take(cfg.images.sheet_views.max(1)) {
-                            if let Some((_, t)) = sheet.iter().find(|(view, _)| *view == v) {
-                                tiles.extend(t.iter().cloned());
-                            }
-                        }
-                        let sheet = raster::contact_sheet(&tiles, 3, 4, [32, 32, 32])?;
-                        crate::io::write_image(
-                            &out_dir
-                                .join("sheets")
-                                .join(&asset.name)
-                                .join(format!("{}.png", lod.name)),
-                            &image::DynamicImage::ImageRgb8(sheet),
-                        )
-                    })
-                    .collect::<Result<()>>()?;
-            }
-            Ok(())
+        let views = Views {
+            cameras: &cameras,
+            reference: &reference_renderer,
+            lods: &lods,
+            renderers: &lod_renderers,
+            orders: &orders,
         };
-        let search_distances = || -> Result<Vec<_>> {
-            if !cfg.distance.enabled {
-                return Ok(Vec::new());
-            }
-            // The LODs' searches in parallel, sharing the original's probe renders; rows in LOD
-            // order.
-            bar.set_message(&format!("{} distances", asset.name));
-            let originals = distance::OriginalProbes::new();
-            let take = cfg.distance.views.unwrap_or(3).max(1);
-            let rows = lods
-                .par_iter()
-                .zip(&orders)
-                .map(|(lod, order)| {
-                    let job = DistanceJob {
-                        original: &reference,
-                        lod: &lod.scene,
-                        directions: order
-                            .iter()
-                            .take(take)
-                            .map(|&v| cameras[v].to_eye())
-                            .collect(),
-                        meters_per_unit: asset.meters_per_unit,
-                        simplifier_error: lod.info.simplifier_error,
-                        names: (&asset.name, &lod.name, lod.info.triangles),
-                        switch_m: lod.info.switch_m,
-                        originals: Some(&originals),
-                    };
-                    let rows = distance::search(&job, &cfg.distance, &cfg.viewing, &settings);
-                    bar.advance(1);
-                    rows
-                })
-                .collect::<Result<Vec<_>>>()?;
-            Ok(rows.into_iter().flatten().collect())
-        };
+        let write_images = || write_images(&shared, &asset.name, &views, &sheets);
+        let search_distances =
+            || search_distances(&shared, asset, &reference, &lods, &orders, &cameras);
         let (written, rows) = rayon::join(write_images, search_distances);
         written?;
         results.distances.extend(rows?);
-        let ext = match cfg.export.gltf {
-            GltfExport::None => None,
-            GltfExport::Glb => Some("glb"),
-            GltfExport::Gltf => Some("gltf"),
-        };
         // A chain for engines: only from a run that has every LOD of the asset (not a shard's
         // part of it).
-        if let (Some(out_dir), Some(ext)) = (images, ext)
+        if let Some(out_dir) = images
             && wanted.iter().all(|w| *w)
         {
-            let chain: Vec<(&str, &Mesh)> = lods
-                .iter()
-                .map(|l| (l.name.as_str(), l.scene.scene().mesh()))
-                .collect();
-            let (_, notes) = super::export::write_chain(
-                &out_dir.join("export").join(format!("{}.{ext}", asset.name)),
-                &asset.name,
-                &original,
-                &chain,
-                &results.distances,
-            )?;
+            let notes = export_chain(cfg, out_dir, &asset.name, &original, &lods, &results)?;
             export_warnings.extend(notes);
         }
         results.lods.extend(lods.into_iter().map(|l| l.info));
@@ -410,15 +226,370 @@ pub fn evaluate(
     let mut warnings: Vec<String> = engine.fallback().map(str::to_string).into_iter().collect();
     warnings.extend(export_warnings);
     warnings.extend(cache.iter().flat_map(|c| c.warnings()));
+    inputs.extend(mesh_files(plan));
+    Ok((results, warnings, inputs))
+}
+
+/// The wanted LODs of `asset` ready to render, with their surface distances to the original
+/// where the config asks for them.
+fn lod_scenes(
+    cfg: &super::config::Config,
+    asset: &AssetPlan,
+    original: &Mesh,
+    wanted: &[bool],
+) -> Result<Vec<LodScene>> {
+    let geometry = (cfg.geometry_samples > 0)
+        .then(|| surface_distance::Original::new(original, cfg.geometry_samples));
+    Ok(build_lods(asset, original, wanted)?
+        .into_iter()
+        .map(|(name, mesh, mut info)| {
+            if let Some(g) = &geometry {
+                let d = g.compare(&mesh);
+                info.hausdorff = Some(round7(d.hausdorff));
+                info.mean_distance = Some(round7(d.mean));
+                info.rms_distance = Some(round7(d.rms));
+                info.hausdorff_relative = Some(round7(d.hausdorff_relative));
+                info.mean_relative = Some(round7(d.mean_relative));
+            }
+            LodScene {
+                name,
+                scene: scene_for(cfg, Arc::new(mesh)),
+                info,
+            }
+        })
+        .collect())
+}
+
+/// An asset's views, renderers and each LOD's views worst first: what the image writers read.
+struct Views<'a, 'r> {
+    cameras: &'a [crate::scene::Camera],
+    reference: &'a SceneRenderer<'r>,
+    lods: &'a [LodScene],
+    renderers: &'a [SceneRenderer<'r>],
+    orders: &'a [Vec<usize>],
+}
+
+/// `heatmaps = "worst"`: re-render each LOD's worst view only, for its heat maps: each distinct
+/// worst view's original once, its LODs in parallel.
+fn worst_heat_maps(
+    out_dir: &Path,
+    asset: &str,
+    views: &Views<'_, '_>,
+    scorer: &Scorer,
+    settings: &raster::RenderSettings,
+) -> Result<()> {
+    let mut worst: Vec<usize> = views
+        .orders
+        .iter()
+        .filter_map(|o| o.first().copied())
+        .collect();
+    worst.sort_unstable();
+    worst.dedup();
+    for view in worst {
+        let camera = &views.cameras[view];
+        let a = LinearImage::from(&views.reference.render(camera, settings)?);
+        let reference = scorer.prepare(a);
+        views
+            .lods
+            .par_iter()
+            .zip(views.renderers)
+            .zip(views.orders)
+            .filter(|(_, order)| order.first() == Some(&view))
+            .map(|((lod, lod_renderer), _)| -> Result<()> {
+                let b = LinearImage::from(&lod_renderer.render(camera, settings)?);
+                let scored = scorer.score(&reference, &b)?;
+                for (metric, map) in &scored.maps {
+                    write_heat_map(out_dir, asset, &lod.name, view, metric, map)?;
+                }
+                Ok(())
+            })
+            .collect::<Result<()>>()?;
+    }
+    Ok(())
+}
+
+/// Each LOD's contact sheet: its `sheet_views` worst views, three tiles each.
+fn write_sheets(
+    out_dir: &Path,
+    asset: &str,
+    views: &Views<'_, '_>,
+    sheets: &[SheetViews],
+    sheet_views: usize,
+) -> Result<()> {
+    views
+        .lods
+        .par_iter()
+        .zip(sheets)
+        .zip(views.orders)
+        .filter(|((_, sheet), _)| !sheet.is_empty())
+        .map(|((lod, sheet), order)| -> Result<()> {
+            let mut tiles = Vec::new();
+            for &v in order.iter().take(sheet_views.max(1)) {
+                if let Some((_, t)) = sheet.iter().find(|(view, _)| *view == v) {
+                    tiles.extend(t.iter().cloned());
+                }
+            }
+            let sheet = raster::contact_sheet(&tiles, 3, 4, [32, 32, 32])?;
+            crate::io::write_image(
+                &out_dir
+                    .join("sheets")
+                    .join(asset)
+                    .join(format!("{}.png", lod.name)),
+                &image::DynamicImage::ImageRgb8(sheet),
+            )
+        })
+        .collect()
+}
+
+/// `[export] gltf`: the asset's chain as one glTF file, switching at the measured distances;
+/// returns what it could not keep.
+fn export_chain(
+    cfg: &super::config::Config,
+    out_dir: &Path,
+    asset: &str,
+    original: &Mesh,
+    lods: &[LodScene],
+    results: &Results,
+) -> Result<Vec<String>> {
+    let ext = match cfg.export.gltf {
+        GltfExport::None => return Ok(Vec::new()),
+        GltfExport::Glb => "glb",
+        GltfExport::Gltf => "gltf",
+    };
+    let chain: Vec<(&str, &Mesh)> = lods
+        .iter()
+        .map(|l| (l.name.as_str(), l.scene.scene().mesh()))
+        .collect();
+    let (_, notes) = super::export::write_chain(
+        &out_dir.join("export").join(format!("{asset}.{ext}")),
+        asset,
+        original,
+        &chain,
+        &results.distances,
+    )?;
+    Ok(notes)
+}
+
+/// The plan's mesh and LOD files as the config names them, also those of assets a shard ran
+/// none of the cases of.
+fn mesh_files(plan: &Plan) -> Vec<PathBuf> {
+    let mut files = Vec::new();
     for asset in &plan.assets {
-        inputs.push(asset.mesh.clone()); // also where this shard ran none of its cases
+        files.push(asset.mesh.clone());
         for l in &asset.lods {
-            if let super::plan::LodSource::File(p) = &l.source {
-                inputs.push(p.clone());
+            if let LodSource::File(p) = &l.source {
+                files.push(p.clone());
             }
         }
     }
-    Ok((results, warnings, inputs))
+    files
+}
+
+/// The original's frame of `camera` (from the render cache where it holds this very frame),
+/// prepared for scoring, and its thumbnail.
+fn reference_view(
+    sh: &Shared<'_>,
+    renderer: &str,
+    cache: Option<(&super::cache::RenderCache, &super::cache::SceneKey)>,
+    reference_renderer: &SceneRenderer,
+    camera: &crate::scene::Camera,
+) -> Result<(super::score::Reference, image::RgbImage)> {
+    let settings = sh.settings;
+    let cached = cache.and_then(|(c, k)| c.get(k, settings, camera, renderer));
+    let reference_image = match cached {
+        Some(px) => LinearImage::new(settings.width as usize, settings.height as usize, px)
+            .ok_or_else(|| crate::error::Error::Internal("render cache: size".into()))?,
+        None => {
+            let image = LinearImage::from(&reference_renderer.render(camera, settings)?);
+            if let Some((c, k)) = cache {
+                c.put(k, settings, camera, renderer, image.pixels());
+            }
+            image
+        }
+    };
+    let prepared = sh.scorer.prepare(reference_image);
+    let ref_thumb = thumbnail(&prepared.srgb8());
+    Ok((prepared, ref_thumb))
+}
+
+/// Render and score every LOD of `lods` from every camera, recording the rows in `results`;
+/// returns each LOD's contact-sheet tiles. The LODs of one view are independent: rendered and
+/// scored in parallel, then recorded in LOD order (outputs never depend on which finished
+/// first). The next view's original is prepared meanwhile, so that no core waits for it.
+fn score_views(
+    sh: &Shared<'_>,
+    asset: &str,
+    cameras: &[crate::scene::Camera],
+    (lods, lod_renderers): (&[LodScene], &[SceneRenderer]),
+    original_view: impl Fn(usize) -> Result<(super::score::Reference, image::RgbImage)> + Sync,
+    renderer: &str,
+    results: &mut Results,
+) -> Result<Vec<SheetViews>> {
+    let mut sheets: Vec<SheetViews> = vec![Vec::new(); lods.len()];
+    let mut next = (!cameras.is_empty()).then(|| original_view(0));
+    for (v, camera) in cameras.iter().enumerate() {
+        let (prepared, ref_thumb) = next.take().expect("prepared ahead")?;
+        let at = ViewAt {
+            asset,
+            v,
+            camera,
+            prepared: &prepared,
+            ref_thumb: &ref_thumb,
+        };
+        let (per_lod, following) = rayon::join(
+            || {
+                lods.par_iter()
+                    .zip(lod_renderers)
+                    .map(|(lod, r)| score_lod(sh, &at, lod, r))
+                    .collect::<Result<Vec<_>>>()
+            },
+            || (v + 1 < cameras.len()).then(|| original_view(v + 1)),
+        );
+        let per_lod = per_lod?;
+        next = following;
+        for (k, (lod, (values, thumbs))) in lods.iter().zip(per_lod).enumerate() {
+            for (metric, value) in values {
+                results.rows.push(MetricRow {
+                    asset: asset.to_string(),
+                    lod: lod.name.clone(),
+                    triangles: lod.info.triangles,
+                    view: v,
+                    metric: metric.to_string(),
+                    value,
+                    renderer: renderer.to_string(),
+                });
+            }
+            if let Some(t) = thumbs {
+                sheets[k].push((v, t));
+            }
+        }
+    }
+    Ok(sheets)
+}
+
+/// The worst views' heat maps (`heatmaps = "worst"`) and the contact sheets, where the run
+/// writes images.
+fn write_images(
+    sh: &Shared<'_>,
+    asset: &str,
+    views: &Views<'_, '_>,
+    sheets: &[SheetViews],
+) -> Result<()> {
+    let (Some(out_dir), cfg) = (sh.images, sh.cfg) else {
+        return Ok(());
+    };
+    if cfg.images.heatmaps == HeatmapChoice::Worst {
+        worst_heat_maps(out_dir, asset, views, sh.scorer, sh.settings)?;
+    }
+    if cfg.images.contact_sheets {
+        write_sheets(out_dir, asset, views, sheets, cfg.images.sheet_views)?;
+    }
+    Ok(())
+}
+
+/// What every case of a run shares.
+struct Shared<'a> {
+    cfg: &'a super::config::Config,
+    settings: &'a raster::RenderSettings,
+    scorer: &'a Scorer,
+    images: Option<&'a Path>,
+    bar: &'a dyn Progress,
+}
+
+/// One view of an asset, with its original prepared for scoring and its thumbnail.
+struct ViewAt<'a> {
+    asset: &'a str,
+    v: usize,
+    camera: &'a crate::scene::Camera,
+    prepared: &'a super::score::Reference,
+    ref_thumb: &'a image::RgbImage,
+}
+
+/// One LOD of one view: rendered, scored, its heat maps written (`heatmaps = "all"`), its
+/// contact-sheet tiles (original, LOD, the first metric's heat map).
+fn score_lod(
+    sh: &Shared<'_>,
+    at: &ViewAt<'_>,
+    lod: &LodScene,
+    lod_renderer: &SceneRenderer,
+) -> Result<LodOfView> {
+    let (v, cfg) = (at.v, sh.cfg);
+    let test_frame = lod_renderer.render(at.camera, sh.settings)?;
+    let scored = sh
+        .scorer
+        .score(at.prepared, &LinearImage::from(&test_frame))?;
+    if let Some(out_dir) = sh.images
+        && cfg.images.heatmaps == HeatmapChoice::All
+    {
+        for (metric, map) in &scored.maps {
+            write_heat_map(out_dir, at.asset, &lod.name, v, metric, map)?;
+        }
+    }
+    let thumbs = scored.maps.first().map(|(metric, map)| {
+        let test_rgb8: Cow<image::RgbImage> = match &scored.srgb8 {
+            Some(rgb) => Cow::Borrowed(rgb),
+            None => Cow::Owned(test_frame.to_srgb8()),
+        };
+        let heat = colormap::heat_map(&map.values, map.width, map.height, 0);
+        let score = scored
+            .values
+            .iter()
+            .find(|(m, _)| m == metric)
+            .map_or(String::new(), |(_, x)| format!(" {x:.4}"));
+        [
+            captioned(at.ref_thumb.clone(), &format!("view {v} · original")),
+            captioned(thumbnail(&test_rgb8), &format!("view {v} · {}", lod.name)),
+            captioned(
+                thumbnail(&heat),
+                &format!("{}{score}", metric.to_uppercase()),
+            ),
+        ]
+    });
+    sh.bar.advance(1);
+    Ok((scored.values, thumbs))
+}
+
+/// The LODs' distance searches in parallel, sharing the original's probe renders; rows in LOD
+/// order (none when the config turns the search off).
+fn search_distances(
+    sh: &Shared<'_>,
+    asset: &AssetPlan,
+    reference: &RenderScene,
+    lods: &[LodScene],
+    orders: &[Vec<usize>],
+    cameras: &[crate::scene::Camera],
+) -> Result<Vec<super::tables::DistanceRow>> {
+    let cfg = sh.cfg;
+    if !cfg.distance.enabled {
+        return Ok(Vec::new());
+    }
+    sh.bar.set_message(&format!("{} distances", asset.name));
+    let originals = distance::OriginalProbes::new();
+    let take = cfg.distance.views.unwrap_or(3).max(1);
+    let rows = lods
+        .par_iter()
+        .zip(orders)
+        .map(|(lod, order)| {
+            let job = DistanceJob {
+                original: reference,
+                lod: &lod.scene,
+                directions: order
+                    .iter()
+                    .take(take)
+                    .map(|&v| cameras[v].to_eye())
+                    .collect(),
+                meters_per_unit: asset.meters_per_unit,
+                simplifier_error: lod.info.simplifier_error,
+                names: (&asset.name, &lod.name, lod.info.triangles),
+                switch_m: lod.info.switch_m,
+                originals: Some(&originals),
+            };
+            let rows = distance::search(&job, &cfg.distance, &cfg.viewing, sh.settings);
+            sh.bar.advance(1);
+            rows
+        })
+        .collect::<Result<Vec<_>>>()?;
+    Ok(rows.into_iter().flatten().collect())
 }
 
 /// A scene of `mesh` with the config's lights, environment, background and ambient term.
