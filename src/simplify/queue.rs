@@ -148,16 +148,19 @@ impl<T: Keyed + Ord + Copy> Lookahead<T> {
     /// Remove and return the least entry for which `keep` holds (others may be dropped on the
     /// way). Entries newly popped ahead are handed to `fetch` first.
     pub fn pop(&mut self, keep: impl Fn(&T) -> bool, mut fetch: impl FnMut(&T)) -> Option<T> {
-        while self.ahead.len() < self.depth {
-            match self.queue.pop(&keep) {
-                Some(x) => {
-                    fetch(&x);
-                    self.ahead.push_back(x);
-                }
-                None => break,
-            }
-        }
         loop {
+            // Refilled on every turn: the entries popped ahead may all have gone stale since,
+            // and the queue is only empty when the radix queue is too (it once ended a run
+            // early when `depth` stale entries in a row were dropped here).
+            while self.ahead.len() < self.depth {
+                match self.queue.pop(&keep) {
+                    Some(x) => {
+                        fetch(&x);
+                        self.ahead.push_back(x);
+                    }
+                    None => break,
+                }
+            }
             let take_early = match (self.early.peek(), self.ahead.front()) {
                 (Some(e), Some(a)) => e < a,
                 (Some(_), None) => true,
@@ -341,5 +344,18 @@ mod tests {
         assert_eq!(q.pop(|_| true), Some((5, 1)));
         assert_eq!(q.pop(|_| true), Some((9, 0)));
         assert_eq!(q.len(), 0);
+    }
+
+    #[test]
+    fn entries_popped_ahead_that_went_stale_do_not_end_the_queue() {
+        // Depth 4: the first pop takes 0 and pops 1..=4 ahead. Those then go stale (as a
+        // collapse makes its neighbours' entries stale); the queue still holds 5..10, and the
+        // next pop must return 5, not report an empty queue.
+        let mut q = Lookahead::new((0u32..10).map(|k| (k, 0u32)).collect(), 4);
+        assert_eq!(q.pop(|_| true, |_| {}), Some((0, 0)));
+        let fresh = |x: &(u32, u32)| x.0 >= 5;
+        assert_eq!(q.pop(fresh, |_| {}), Some((5, 0)));
+        let rest: Vec<u32> = std::iter::from_fn(|| q.pop(fresh, |_| {}).map(|x| x.0)).collect();
+        assert_eq!(rest, vec![6, 7, 8, 9]);
     }
 }
