@@ -147,10 +147,23 @@ pub fn scatter_identity(
         .iter()
         .flat_map(|p| [p.0, p.1])
         .fold(f64::NEG_INFINITY, f64::max);
+    // Ticks about eight to the side, at 1, 2, 2.5 or 5 times a power of ten (0.25 for
+    // log10 sensitivities, 2.5 or 5 for dB).
+    let step = if lo.is_finite() && hi > lo {
+        let raw = (hi - lo + 0.1) / 8.0;
+        let decade = 10f64.powf(raw.log10().floor());
+        [1.0, 2.0, 2.5, 5.0, 10.0]
+            .into_iter()
+            .map(|k| k * decade)
+            .find(|&s| s >= raw * 0.999)
+            .unwrap_or(10.0 * decade)
+    } else {
+        0.25
+    };
     let (lo, hi) = if lo.is_finite() && hi > lo {
         (
-            ((lo - 0.05) * 4.0).floor() / 4.0,
-            ((hi + 0.05) * 4.0).ceil() / 4.0,
+            ((lo - 0.05) / step).floor() * step,
+            ((hi + 0.05) / step).ceil() * step,
         )
     } else {
         (0.0, 1.0)
@@ -176,7 +189,7 @@ pub fn scatter_identity(
             m - 4.0,
             py(t) + 4.0
         );
-        t += 0.25;
+        t += step;
     }
     for (offset, dash) in [
         (0.0, ""),

@@ -37,6 +37,7 @@
 //!   independence, views, bad requests, and the paper experiment on a tiny config.
 
 mod bad_input;
+mod calibration;
 mod cli;
 mod common;
 mod eval;

@@ -370,6 +370,7 @@ fn calibrate_prints_json_and_writes_the_table_and_plot() {
     ]);
     assert_eq!(r.code, 0, "{}", r.stderr);
     let v: serde_json::Value = serde_json::from_str(&r.stdout).unwrap();
+    let v = &v["modelfest"];
     let rmse = v["rmse_log10"].as_f64().unwrap();
     assert!(rmse > 0.0 && rmse <= 0.10);
     let stimuli = v["stimuli"].as_array().unwrap();

@@ -37,14 +37,20 @@
 //! Here the sum is over visual angle and its scale is the observers'.
 
 mod adaptation;
+pub mod agreement;
 pub(crate) mod bands;
+pub mod castle;
 mod display;
 mod filter;
 pub mod fitted;
+pub mod foley;
 pub(crate) mod masking;
 pub mod modelfest;
 mod pooling;
 mod psychometric;
+pub mod stimuli;
+mod table;
+pub mod threshold;
 
 use std::sync::{Arc, Mutex};
 

@@ -15,9 +15,8 @@
 //! For each stimulus the reference image is the uniform background L0 and the test image
 //! L0·(1 + c·s); the predicted threshold is the contrast c at which the VDP's detection probability
 //! is the observers' criterion ([`THRESHOLD_PROBABILITY`]: 2AFC 84 % correct, corrected for
-//! guessing, i.e. pooled sum S = 1). It is found by a bracketed secant (Illinois) search on ln c:
-//! S grows about as c^β, so ln S is nearly linear in ln c and a few steps reach |ln S| < 10⁻⁶.
-//! The predicted log10 sensitivity is −log10 c.
+//! guessing, i.e. pooled sum S = 1), found by `threshold.rs`. The predicted log10 sensitivity is
+//! −log10 c.
 
 use std::path::Path;
 
@@ -278,57 +277,13 @@ fn load_pattern(path: &Path) -> Result<Vec<f32>> {
         .collect())
 }
 
-/// The pooled sum S of `stimulus` at contrast `c` against its uniform background.
-fn pooled_sum(vdp: &Vdp, background: &super::VdpPrepared, pattern: &[f32], l0: f32, c: f64) -> f64 {
-    let test = pattern.iter().map(|&s| l0 * (1.0 + c as f32 * s)).collect();
-    let prepared = vdp.prepare_luminance(SIDE, SIDE, test);
-    let score = vdp
-        .compare_prepared(background, &prepared)
-        .expect("both images are SIDE × SIDE");
-    score.jnd.powf(vdp.params().beta)
-}
-
-/// Threshold contrast of one pattern: S(c) = 1.
+/// Threshold contrast of one pattern against its uniform background (the bracket's end where
+/// the search stops at one: ModelFest's stimuli all lie well inside it).
 fn threshold(vdp: &Vdp, background: &super::VdpPrepared, pattern: &[f32], l0: f32) -> f64 {
-    let f = |ln_c: f64| {
-        pooled_sum(vdp, background, pattern, l0, ln_c.exp())
-            .max(1e-300)
-            .ln()
-    };
-    // Bracket ln c in [ln 1e-6, ln 1] (contrast above 100 % is not a stimulus).
-    let (mut a, mut b) = (1e-6f64.ln(), 0.0f64);
-    let (mut fa, mut fb) = (f(a), f(b));
-    if fb < 0.0 {
-        return 1.0; // invisible even at full contrast: threshold reported as 100 %.
-    }
-    if fa > 0.0 {
-        return 1e-6;
-    }
-    // Illinois false position: the side that stays keeps half its weight.
-    let mut side = 0i8;
-    for _ in 0..60 {
-        let c = (a * fb - b * fa) / (fb - fa);
-        let fc = f(c);
-        if fc.abs() < 1e-6 || (b - a).abs() < 1e-9 {
-            return c.exp();
-        }
-        if fc < 0.0 {
-            a = c;
-            fa = fc;
-            if side == -1 {
-                fb *= 0.5;
-            }
-            side = -1;
-        } else {
-            b = c;
-            fb = fc;
-            if side == 1 {
-                fa *= 0.5;
-            }
-            side = 1;
-        }
-    }
-    (0.5 * (a + b)).exp()
+    super::threshold::threshold(vdp, background, |c| {
+        pattern.iter().map(|&s| l0 * (1.0 + c as f32 * s)).collect()
+    })
+    .contrast
 }
 
 /// Run the check: every stimulus's predicted threshold at `condition` with `params`.
