@@ -445,7 +445,8 @@ pub struct DistanceConfig {
     /// Largest on-screen object diameter searched, pixels; a LOD still visible there is reported
     /// as visible at every distance down to it. Default value: 512.
     pub max_diameter_px: ImageSize,
-    /// Views of the rig used (the first N in the rig's numbering). Default value: all.
+    /// How many views the search probes: the N worst of the full-size evaluation (by FLIP, else
+    /// the first metric), worst first — the worst view decides. Default value: 3.
     pub views: Option<usize>,
 }
 
