@@ -23,7 +23,7 @@ pub(crate) enum CalibrationSet {
 
 #[derive(Args, Debug)]
 #[command(
-    after_help = "Examples:\n  lodeval calibrate modelfest\n  lodeval calibrate all --json --out results/calibration\n\nExit codes: 0 calibrated and reported · 2 a missing or damaged oracle, or bad conditions · 3 internal error"
+    after_help = "Example:\n  lodeval calibrate modelfest\n  lodeval calibrate all --json --out results/calibration\n\nExit codes: 0 calibrated and reported · 2 a missing or damaged oracle, or bad conditions · 3 internal error"
 )]
 pub(crate) struct CalibrateArgs {
     /// The human data.
