@@ -22,8 +22,13 @@
 //! display's height), so the gate's question — visible where the engine uses it? — has an answer.
 //! Where the search hits a limit the row says which bound it is (`DistanceBound`): visible even
 //! at the smallest size (imperceptible only farther than the distance given) or invisible up to
-//! the largest (imperceptible from the distance given at the latest). Views: the `views` worst views of the full-size evaluation (by FLIP, else the first
-//! metric), since the worst view decides.
+//! the largest (imperceptible from the distance given at the latest). Views: the `views` worst
+//! views of the full-size evaluation (by FLIP, else the first metric; `eval::run::worst_first`
+//! orders them), since the worst view decides.
+//!
+//! To look at a verdict: [`probe_views`] gives the probe renders at one size (both images and
+//! each view's probability, JND and FLIP), [`search_trace`] the worst view's values at every size
+//! the search probed, [`visibility_at`] the worst view's values at a distance in metres.
 //!
 //! Engine parameters at that distance (all from the same sphere, so they agree with each other):
 //! Unity's LODGroup relative screen height (diameter / screen height, `screen_height_fraction`),
@@ -202,6 +207,56 @@ impl<'a> Prober<'a> {
         }
     }
 
+    /// The camera and render settings of the probe at on-screen diameter `diameter` (pixels)
+    /// seen from direction `dir`: the viewer at the distance that gives that diameter, a square
+    /// crop around the disc with a 10 % + 4 px border on each side, at the display's pixel scale.
+    fn camera(&self, diameter: f64, dir: Vec3) -> (Camera, RenderSettings) {
+        let (display, sphere) = (&self.display, self.sphere);
+        let r_units = sphere.radius as f64;
+        let d_units = display.distance_for(r_units, diameter);
+        let size = (diameter * 1.1).ceil() as u32 + 8;
+        let mut s = self.settings;
+        s.width = size;
+        s.height = size;
+        s.samples = SamplePattern::Rotated(self.side);
+        // The crop's field of view at the display's pixel scale.
+        let fov = 2.0 * ((size as f64 / 2.0) / display.k).atan();
+        let mut cam = Camera::frame_sphere(sphere, dir, 30.0, 1.0, 0.0);
+        let eye_dir = cam.to_eye();
+        cam.eye = sphere.center + eye_dir * d_units as f32;
+        cam.projection = Projection::Perspective {
+            fov_y_deg: fov.to_degrees() as f32,
+        };
+        cam.near = ((d_units - r_units * 1.01) as f32).max(d_units as f32 * 1e-4);
+        cam.far = (d_units + r_units * 1.01) as f32;
+        (cam, s)
+    }
+
+    /// The original's prepared render for a probe.
+    fn prepare_original(&self, image: &LinearImage) -> PreparedOriginal {
+        PreparedOriginal {
+            vdp: self.vdp.prepare(image),
+            flip: self.flip.as_ref().map(|f| f.prepare(image)),
+        }
+    }
+
+    /// One view's scores: the LOD's render against the original's prepared one.
+    fn score(&self, original: &PreparedOriginal, lod: &LinearImage) -> Result<Probe> {
+        let v = self
+            .vdp
+            .compare_prepared(&original.vdp, &self.vdp.prepare(lod))?;
+        let f = match (&self.flip, &original.flip) {
+            (Some(flip), Some(fa)) => flip.compare_prepared(fa, &flip.prepare(lod))?.mean,
+            _ => 0.0,
+        };
+        Ok(Probe {
+            vdp: v.probability,
+            vdp_jnd: v.jnd,
+            flip: f,
+            complete: true,
+        })
+    }
+
     /// Worst over the views at on-screen diameter `diameter` (pixels); `originals` holds (and
     /// receives) the original's prepared renders. Views run two at a time in parallel, in the
     /// job's order; where `enough` holds for the worst so far the rest are skipped (the worst can
@@ -213,51 +268,20 @@ impl<'a> Prober<'a> {
         originals: &OriginalProbes,
         enough: Option<&dyn Fn(&Probe) -> bool>,
     ) -> Result<Probe> {
-        let (display, sphere) = (&self.display, self.sphere);
-        let r_units = sphere.radius as f64;
-        let d_units = display.distance_for(r_units, diameter);
-        // A square crop around the disc with a 10 % + 4 px border on each side.
-        let size = (diameter * 1.1).ceil() as u32 + 8;
-        let mut s = self.settings;
-        s.width = size;
-        s.height = size;
-        s.samples = SamplePattern::Rotated(self.side);
-        // The crop's field of view at the display's pixel scale.
-        let fov = 2.0 * ((size as f64 / 2.0) / display.k).atan();
         let view = |dir: Vec3| -> Result<Probe> {
-            let mut cam = Camera::frame_sphere(sphere, dir, 30.0, 1.0, 0.0);
-            let dir = cam.to_eye();
-            cam.eye = sphere.center + dir * d_units as f32;
-            cam.projection = Projection::Perspective {
-                fov_y_deg: fov.to_degrees() as f32,
-            };
-            cam.near = ((d_units - r_units * 1.01) as f32).max(d_units as f32 * 1e-4);
-            cam.far = (d_units + r_units * 1.01) as f32;
+            let (cam, s) = self.camera(diameter, dir);
             let key = (
                 diameter.to_bits(),
-                dir.to_array().map(f32::to_bits),
+                cam.to_eye().to_array().map(f32::to_bits),
                 self.side,
                 self.flip.is_some(),
             );
             let a = originals.get_or_make(key, || {
                 let a = LinearImage::from(&raster::render(self.job.original, &cam, &s)?);
-                Ok(PreparedOriginal {
-                    vdp: self.vdp.prepare(&a),
-                    flip: self.flip.as_ref().map(|f| f.prepare(&a)),
-                })
+                Ok(self.prepare_original(&a))
             })?;
             let b = LinearImage::from(&raster::render(self.job.lod, &cam, &s)?);
-            let v = self.vdp.compare_prepared(&a.vdp, &self.vdp.prepare(&b))?;
-            let f = match (&self.flip, &a.flip) {
-                (Some(flip), Some(fa)) => flip.compare_prepared(fa, &flip.prepare(&b))?.mean,
-                _ => 0.0,
-            };
-            Ok(Probe {
-                vdp: v.probability,
-                vdp_jnd: v.jnd,
-                flip: f,
-                complete: true,
-            })
+            self.score(&a, &b)
         };
         let mut worst = Probe {
             vdp: 0.0,
@@ -285,6 +309,53 @@ impl<'a> Prober<'a> {
         }
         Ok(worst)
     }
+}
+
+/// One view of a probe, rendered and scored as [`search`] renders and scores it.
+#[derive(Debug, Clone)]
+pub struct ViewProbe {
+    /// The view's direction (from the object's centre towards the eye).
+    pub direction: Vec3,
+    /// The original's render.
+    pub original: LinearImage,
+    /// The LOD's render.
+    pub lod: LinearImage,
+    /// VDP detection probability of the pair.
+    pub vdp: f64,
+    /// VDP difference in JND.
+    pub vdp_jnd: f64,
+    /// FLIP mean of the pair.
+    pub flip: f64,
+}
+
+/// The probe renders at on-screen diameter `diameter_px`, one per view of `job` in its order,
+/// with each view's scores: what [`search`] looks at for that size (its decision is the worst
+/// view's). For looking at a verdict, or testing one.
+pub fn probe_views(
+    job: &DistanceJob,
+    viewing: &ViewingConfig,
+    settings: &RenderSettings,
+    samples: SampleCount,
+    diameter_px: f64,
+) -> Result<Vec<ViewProbe>> {
+    let prober = Prober::new(job, viewing, settings, samples.side(), true);
+    job.directions
+        .par_iter()
+        .map(|&dir| {
+            let (cam, s) = prober.camera(diameter_px, dir);
+            let original = LinearImage::from(&raster::render(job.original, &cam, &s)?);
+            let lod = LinearImage::from(&raster::render(job.lod, &cam, &s)?);
+            let p = prober.score(&prober.prepare_original(&original), &lod)?;
+            Ok(ViewProbe {
+                direction: cam.to_eye(),
+                original,
+                lod,
+                vdp: p.vdp,
+                vdp_jnd: p.vdp_jnd,
+                flip: p.flip,
+            })
+        })
+        .collect()
 }
 
 /// How visible `job`'s LOD is at `distance_m` metres (viewer to the bounding sphere's centre):
@@ -323,6 +394,22 @@ struct Probe {
     complete: bool,
 }
 
+/// The worst view's values at one on-screen size the search probed.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ProbedSize {
+    /// On-screen diameter of the bounding sphere, pixels.
+    pub diameter_px: u32,
+    /// Worst view's VDP detection probability.
+    pub vdp: f64,
+    /// Worst view's VDP JND.
+    pub vdp_jnd: f64,
+    /// Worst view's FLIP mean.
+    pub flip: f64,
+    /// Every view scored; false where the probe stopped early, already visible by every
+    /// criterion (its decisions hold, its values are lower bounds).
+    pub complete: bool,
+}
+
 /// Find the distances for one LOD: one row for the VDP criterion and one for FLIP if configured.
 pub fn search(
     job: &DistanceJob,
@@ -330,17 +417,28 @@ pub fn search(
     viewing: &ViewingConfig,
     settings: &RenderSettings,
 ) -> Result<Vec<DistanceRow>> {
+    search_probing(job, config, viewing, settings, true).map(|(rows, _)| rows)
+}
+
+/// [`search`], with the values at every size it probed, smallest first.
+pub fn search_trace(
+    job: &DistanceJob,
+    config: &DistanceConfig,
+    viewing: &ViewingConfig,
+    settings: &RenderSettings,
+) -> Result<(Vec<DistanceRow>, Vec<ProbedSize>)> {
     search_probing(job, config, viewing, settings, true)
 }
 
-/// [`search`], with probes that stop early (`early`) or score every view (the test's reference).
+/// [`search`], with probes that stop early (`early`) or score every view (the test's reference),
+/// and the values at every size probed.
 fn search_probing(
     job: &DistanceJob,
     config: &DistanceConfig,
     viewing: &ViewingConfig,
     settings: &RenderSettings,
     early: bool,
-) -> Result<Vec<DistanceRow>> {
+) -> Result<(Vec<DistanceRow>, Vec<ProbedSize>)> {
     let display = Screen::new(viewing);
     let prober = Prober::new(
         job,
@@ -447,7 +545,17 @@ fn search_probing(
             bound,
         });
     }
-    Ok(rows)
+    let probed = probes
+        .iter()
+        .map(|(&diameter_px, p)| ProbedSize {
+            diameter_px,
+            vdp: p.vdp,
+            vdp_jnd: p.vdp_jnd,
+            flip: p.flip,
+            complete: p.complete,
+        })
+        .collect();
+    Ok((rows, probed))
 }
 
 /// The smallest and largest on-screen diameters searched, pixels: [`MIN_PROBE`] to
@@ -516,13 +624,53 @@ mod tests {
             ..DistanceConfig::default()
         };
         let (viewing, settings) = (ViewingConfig::default(), RenderSettings::DEFAULT);
-        let full = search_probing(&job(None), &config, &viewing, &settings, false).unwrap();
-        let early = search_probing(&job(None), &config, &viewing, &settings, true).unwrap();
+        let (full, trace) =
+            search_probing(&job(None), &config, &viewing, &settings, false).unwrap();
+        let (early, _) = search_probing(&job(None), &config, &viewing, &settings, true).unwrap();
         let cached = search(&job(Some(&shared)), &config, &viewing, &settings).unwrap();
         assert_eq!(full.len(), 2);
         assert_eq!(full, early);
         assert_eq!(full, cached);
         assert!(!shared.lock().is_empty());
+        // The trace holds every size probed, smallest first, the reported one among them with
+        // the row's values; the VDP row's size is invisible there, and the next size probed up
+        // visible (unless the search hit its limit).
+        assert!(
+            trace
+                .windows(2)
+                .all(|w| w[0].diameter_px < w[1].diameter_px)
+        );
+        let row = &full[0];
+        let at = trace
+            .iter()
+            .position(|p| p.diameter_px as f64 == row.diameter_px.round())
+            .expect("the reported size was probed");
+        assert_eq!(Some(round7(trace[at].vdp)), row.vdp_probability);
+        assert!(trace[at].vdp <= config.probability.0);
+        if row.bound == DistanceBound::Measured {
+            assert!(trace[at + 1].vdp > config.probability.0, "{trace:?}");
+        }
+        // The probe renders at that size: one per view, the crop the search renders, and the
+        // worst view's values are the row's.
+        let views = probe_views(
+            &job(None),
+            &viewing,
+            &settings,
+            config.samples,
+            trace[at].diameter_px as f64,
+        )
+        .unwrap();
+        assert_eq!(views.len(), 4);
+        let side = (trace[at].diameter_px as f64 * 1.1).ceil() as usize + 8;
+        assert!(
+            views
+                .iter()
+                .all(|v| v.original.width() == side && v.lod.width() == side)
+        );
+        let worst = views.iter().map(|v| v.vdp).fold(0.0, f64::max);
+        assert_eq!(worst, trace[at].vdp);
+        let worst_jnd = views.iter().map(|v| v.vdp_jnd).fold(0.0, f64::max);
+        assert_eq!(Some(round7(worst_jnd)), row.vdp_jnd);
     }
 
     #[test]
