@@ -73,12 +73,23 @@ pub fn written_under(root: &Path) -> Vec<PathBuf> {
 
 /// What an interruption (SIGINT, SIGTERM) leaves undone: every temporary, lock file and file
 /// written into an owned folder is removed, so nothing half-written looks complete.
+///
+/// The two lists' locks are taken and never given back: a worker thread about to create a
+/// temporary ([`Staged::write`]) or to put a file in place ([`Staged::commit`], which renames and
+/// lists it under the lock) waits on them until the process exits, so nothing lands after the
+/// removal. (A file renamed into place just before the signal, and listed a moment after the
+/// removal, once outlived an interrupted run.) Call it only on the way out.
 pub fn interrupted() {
-    remove_temporaries();
-    let (files, _) = std::mem::take(&mut *written());
-    for f in files.iter().rev() {
+    let temporaries = live();
+    let files = written();
+    for t in temporaries.iter() {
+        let _ = std::fs::remove_file(t);
+    }
+    for f in files.0.iter().rev() {
         let _ = std::fs::remove_file(f);
     }
+    std::mem::forget(files);
+    std::mem::forget(temporaries);
 }
 
 /// The temporary that stands for `path` until it is renamed into place.
@@ -111,10 +122,14 @@ impl Staged {
             )));
         }
         let tmp = temporary(path)?;
-        live().insert(tmp.clone());
         self.files.push((tmp.clone(), path.to_path_buf()));
-        std::fs::File::create(&tmp)
-            .and_then(|mut f| f.write_all(bytes).and_then(|_| f.sync_all()))
+        // Listed and created under the lock, so an interruption removes it or it never exists.
+        let file = {
+            let mut temporaries = live();
+            temporaries.insert(tmp.clone());
+            std::fs::File::create(&tmp)
+        };
+        file.and_then(|mut f| f.write_all(bytes).and_then(|_| f.sync_all()))
             .map_err(|e| super::cannot_write(path, e))
     }
 
@@ -129,7 +144,10 @@ impl Staged {
     pub fn commit(mut self) -> Result<()> {
         let files = std::mem::take(&mut self.files);
         for (i, (tmp, dest)) in files.iter().enumerate() {
+            // Put in place and listed under one lock, so an interruption sees both or neither.
+            let mut w = written();
             if let Err(e) = std::fs::rename(tmp, dest) {
+                drop(w);
                 // Not all of it can land: take back what did, so no part stands alone.
                 for (_, d) in &files[..i] {
                     let _ = std::fs::remove_file(d);
@@ -140,12 +158,12 @@ impl Staged {
                 }
                 return Err(super::cannot_write(dest, e));
             }
-            live().remove(tmp);
             let dest = super::target(dest);
-            let mut w = written();
             if w.1.iter().any(|r| dest.starts_with(r)) {
                 w.0.insert(dest);
             }
+            drop(w);
+            live().remove(tmp);
         }
         Ok(())
     }
