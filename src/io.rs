@@ -12,10 +12,7 @@ pub mod plot;
 pub mod plot_png;
 pub mod staged;
 
-pub use staged::{
-    Staged, disown, forget, interrupted, own, remove_on_interrupt, remove_temporaries,
-    written_under,
-};
+pub use staged::{Staged, disown, forget, interrupted, own, remove_on_interrupt, written_under};
 
 use std::io::Read;
 use std::path::{Path, PathBuf};

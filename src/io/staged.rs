@@ -30,13 +30,6 @@ fn written() -> std::sync::MutexGuard<'static, (BTreeSet<PathBuf>, Vec<PathBuf>)
     WRITTEN.lock().unwrap_or_else(|p| p.into_inner())
 }
 
-/// Remove every temporary file still open.
-pub fn remove_temporaries() {
-    for t in std::mem::take(&mut *live()) {
-        let _ = std::fs::remove_file(t);
-    }
-}
-
 /// List `path` with the temporaries: removed on interruption unless [`forget`] first (a lock file).
 pub fn remove_on_interrupt(path: &Path) {
     live().insert(path.to_path_buf());
