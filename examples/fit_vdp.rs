@@ -4,12 +4,16 @@
 //! the values are then written into `fitted.rs` by hand (nothing is fitted at run time).
 //!
 //! Run from the repository root: `cargo run --release --example fit_vdp [-- --evals N]
-//! [--from-published]`. Parameters are searched as (ln P, ε, ob, β), from the current constants or
-//! from Daly's published ones (P = 250, ε = 0.9, ob = 0.78, β = 3.5).
+//! [--from-published] [--beta B] [--check]`. Parameters are searched as (ln P, ε, ob, β), from the
+//! current constants or from Daly's published ones (P = 250, ε = 0.9, ob = 0.78, β = 3.5).
+//! `--beta B` holds β (spatial summation) at B and fits the other three; `--check` then scores
+//! the fit on the castleCSF subset (mean over datasets after a per-dataset factor, dB), the data
+//! that constrain spatial summation across sizes, which ModelFest alone does not.
 
 use std::path::Path;
 
 use lodeval::metric::csf::DalyCsf;
+use lodeval::metric::vdp::castle::{self, CastleCsf};
 use lodeval::metric::vdp::modelfest::{Condition, ModelFest, calibrate};
 use lodeval::metric::vdp::{VdpParams, fitted};
 use lodeval::simplify::lindstrom_turk::simplex::minimize;
@@ -24,9 +28,20 @@ fn main() {
         .nth(1)
         .and_then(|v| v.parse().ok())
         .unwrap_or(200);
+    let beta: Option<f64> = std::env::args()
+        .skip_while(|a| a != "--beta")
+        .nth(1)
+        .and_then(|v| v.parse().ok());
     let data = ModelFest::load(Path::new("reference/oracles/modelfest")).expect("oracle folder");
+    let full = |x: &[f64]| -> Vec<f64> {
+        let mut v = x.to_vec();
+        if let Some(b) = beta {
+            v.push(b);
+        }
+        v
+    };
     let rmse = |x: &[f64]| -> f64 {
-        match params(x) {
+        match params(&full(x)) {
             Some(p) => calibrate(&data, p, Condition::MODELFEST)
                 .map(|c| c.rmse_log10)
                 .unwrap_or(f64::INFINITY),
@@ -43,10 +58,15 @@ fn main() {
             fitted::BETA,
         ]
     };
+    if let Some(b) = beta {
+        x[3] = b;
+        x.truncate(3);
+    }
     let mut fx = rmse(&x);
     eprintln!("start {x:?}: RMSE {fx:.5}");
     // Restart the simplex from its best point until a restart no longer improves the fit.
     let mut steps = vec![0.05, 0.05, 0.05, 0.1];
+    steps.truncate(x.len());
     for round in 0..20 {
         let m = minimize(&x, fx, &steps, evals, &rmse);
         eprintln!(
@@ -61,6 +81,7 @@ fn main() {
         }
         steps.iter_mut().for_each(|s| *s *= 0.5);
     }
+    let x = full(&x);
     println!(
         "P = {:.4}, epsilon = {:.5}, ob = {:.5}, beta = {:.5}: RMSE {:.5} log10",
         x[0].exp(),
@@ -69,4 +90,15 @@ fn main() {
         x[3],
         fx
     );
+    if std::env::args().any(|a| a == "--check") {
+        let castle = CastleCsf::load(Path::new("reference/oracles/castlecsf")).expect("castleCSF");
+        let c = castle::calibrate(&castle, params(&x).expect("fitted"), None).expect("castleCSF");
+        println!(
+            "castleCSF: {:.3} dB as predicted, {:.3} dB after a factor per dataset",
+            c.rmse_db, c.rmse_adjusted_db
+        );
+        for d in &c.datasets {
+            println!("  {:<14} {:.2} dB", d.dataset, d.rmse_adjusted_db);
+        }
+    }
 }

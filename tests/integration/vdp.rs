@@ -13,6 +13,7 @@ use lodeval::mesh::shapes;
 use lodeval::metric::LinearImage;
 use lodeval::metric::csf::daly_rushmeier;
 use lodeval::metric::vdp::modelfest::{Condition, ModelFest, calibrate};
+use lodeval::metric::vdp::threshold::threshold;
 use lodeval::metric::vdp::{Display, Vdp, VdpParams};
 use lodeval::raster::{self, RenderScene, RenderSettings, with_threads};
 use lodeval::scene::{Rig, Viewing};
@@ -552,4 +553,75 @@ fn the_display_model_is_checked_and_matters() {
         dim < office && glare < 0.5 * office,
         "{office} {dim} {glare}"
     );
+}
+
+/// A `side × side` luminance image (cd/m²) of `background` with a centred `px`-pixel disc (64
+/// samples per pixel at the rim) at contrast `c`; `sides` > 0 makes it a regular polygon with that
+/// many corners inscribed in the disc.
+fn disc_in_crop(side: usize, px: f64, c: f64, sides: u32) -> Vec<f32> {
+    let (r, o) = (px / 2.0, side as f64 / 2.0);
+    let inside = |x: f64, y: f64| {
+        let (dx, dy) = (x - o, y - o);
+        let d = dx.hypot(dy);
+        if sides == 0 {
+            return d <= r;
+        }
+        // Inscribed polygon: the distance to its edge along this direction.
+        let sector = std::f64::consts::TAU / sides as f64;
+        let a = dy.atan2(dx).rem_euclid(sector) - sector / 2.0;
+        d * a.cos() <= r * (sector / 2.0).cos()
+    };
+    (0..side * side)
+        .map(|i| {
+            let (x, y) = ((i % side) as f64, (i / side) as f64);
+            let covered = (0..64)
+                .filter(|s| {
+                    inside(
+                        x + (s % 8) as f64 / 8.0 + 1.0 / 16.0,
+                        y + (s / 8) as f64 / 8.0 + 1.0 / 16.0,
+                    )
+                })
+                .count() as f64
+                / 64.0;
+            (50.0 * (1.0 + c * covered)) as f32
+        })
+        .collect()
+}
+
+#[test]
+fn padding_with_background_does_not_move_a_verdict() {
+    // A detection model must not care how tightly the image around a change was cropped: the
+    // distance search scores crops around the object, and before the VDP gave images a surround
+    // (`padding.rs`) an 8 px disc needed 0.050 contrast in a crop of its own size against 0.033 in
+    // a crop three times as large. Discs of 8, 16 and 32 px at 60 ppd, crops of 1× (the disc
+    // plus a pixel each side) and 3× their size: thresholds within 5 %; and a hexagon against
+    // the disc it approximates (the change an LOD makes) scores the same JND in both crops.
+    let (ppd, bg) = (60.0, 50.0f32);
+    let vdp = Vdp::with_params(ppd, Display::DEFAULT, VdpParams::fitted());
+    for px in [8usize, 16, 32] {
+        let crops = [px + 2, 3 * px];
+        let t: Vec<f64> = crops
+            .iter()
+            .map(|&side| {
+                let background = vdp.prepare_luminance(side, side, vec![bg; side * side]);
+                threshold(&vdp, &background, |c| disc_in_crop(side, px as f64, c, 0)).contrast
+            })
+            .collect();
+        let j: Vec<f64> = crops
+            .iter()
+            .map(|&side| {
+                let prepare = |sides| {
+                    vdp.prepare_luminance(side, side, disc_in_crop(side, px as f64, 0.5, sides))
+                };
+                let score = vdp.compare_prepared(&prepare(0), &prepare(6)).unwrap();
+                score.jnd
+            })
+            .collect();
+        eprintln!(
+            "{px} px: threshold {:.4} / {:.4}, hexagon {:.3} / {:.3} JND",
+            t[0], t[1], j[0], j[1]
+        );
+        assert!((t[0] / t[1] - 1.0).abs() < 0.05, "{px} px: {t:?}");
+        assert!((j[0] / j[1] - 1.0).abs() < 0.05, "{px} px: {j:?}");
+    }
 }

@@ -11,6 +11,8 @@
 //! sensitivity at the local adaptation luminance).
 //!
 //! The stages, one file each, in the order they run:
+//! 0. `padding.rs` — a surround of 1° of the image's border median on every side, so that how
+//!    tightly an image was cropped does not change its verdict; maps are cropped back.
 //! 1. `display.rs` — linear pixels → luminance L in cd/m² (peak, black level, ambient reflection);
 //!    then ln L, whose small differences are Weber contrasts.
 //! 2. `filter.rs` — the CSF (Daly's, fitted) as a linear filter in the DCT domain, at the reference
@@ -46,6 +48,7 @@ pub mod fitted;
 pub mod foley;
 pub(crate) mod masking;
 pub mod modelfest;
+mod padding;
 mod pooling;
 mod psychometric;
 pub mod stimuli;
@@ -129,6 +132,9 @@ pub struct Vdp {
 pub struct VdpPrepared {
     width: usize,
     height: usize,
+    /// The uniform margin added on every side (`padding.rs`); the planes below are
+    /// `(width + 2·margin) × (height + 2·margin)`.
+    margin: usize,
     bands: Vec<Plane>,
     maskers: Vec<Vec<f32>>,
     residual: Plane,
@@ -145,6 +151,22 @@ pub struct VdpScore {
     /// Per-pixel detection probability in [0, 1] of the difference around the pixel
     /// ([`MAP_WINDOW_DEG`]); never above `probability`.
     pub map: ErrorMap,
+}
+
+impl VdpPrepared {
+    /// The size of the padded planes.
+    fn padded_size(&self) -> (usize, usize) {
+        (self.width + 2 * self.margin, self.height + 2 * self.margin)
+    }
+
+    /// The image's own `width × height` window of a padded per-pixel map.
+    fn crop(&self, padded: Vec<f32>) -> ErrorMap {
+        ErrorMap {
+            width: self.width,
+            height: self.height,
+            values: padding::crop(&padded, self.width, self.height, self.margin),
+        }
+    }
 }
 
 impl Vdp {
@@ -249,14 +271,16 @@ impl Vdp {
     /// finite and positive): stimuli specified in luminance, such as ModelFest's.
     pub fn prepare_luminance(&self, w: usize, h: usize, luminance: Vec<f32>) -> VdpPrepared {
         assert_eq!(luminance.len(), w * h, "one luminance per pixel");
-        let lum = Plane { w, h, v: luminance };
+        let margin = padding::margin(self.ppd);
+        let lum = padding::pad(&Plane { w, h, v: luminance }, margin);
+        let (pw, ph) = (lum.w, lum.h);
         // Stage 1's logarithm (Weber contrast), then the CSF filter.
         let log = Plane {
-            w,
-            h,
+            w: pw,
+            h: ph,
             v: lum
                 .v
-                .par_chunks(w)
+                .par_chunks(pw)
                 .flat_map_iter(|row| {
                     map_runs(row.iter().copied(), |l| {
                         l.max(adaptation::L_MIN as f32).ln()
@@ -264,7 +288,7 @@ impl Vdp {
                 })
                 .collect(),
         };
-        let filtered = self.filter(w, h).apply(&log);
+        let filtered = self.filter(pw, ph).apply(&log);
         let (mut bands, mut residual) = bands::laplacian(&filtered, self.max_levels);
         // Local adaptation from the Gaussian pyramid of luminance, one level below each band.
         let gauss = bands::gaussian(&lum, bands.len() + 1);
@@ -280,6 +304,7 @@ impl Vdp {
         VdpPrepared {
             width: w,
             height: h,
+            margin,
             bands,
             maskers,
             residual,
@@ -296,7 +321,6 @@ impl Vdp {
             (reference.width, reference.height),
             (test.width, test.height),
         )?;
-        let (w, h) = (reference.width, reference.height);
         // Stage 5: masked band differences.
         let masked: Vec<Plane> = (0..reference.bands.len())
             .map(|k| {
@@ -335,16 +359,12 @@ impl Vdp {
         // Stage 6: one difference image, pooled over visual angle.
         let d = bands::collapse(masked, residual);
         let (sum, density) = pooling::minkowski(&d, self.ppd, self.params.beta);
-        let map = pooling::probability_map(&density, w, h, self.ppd);
+        let map = pooling::probability_map(&density, d.w, d.h, self.ppd);
         // Stage 7.
         Ok(VdpScore {
             probability: psychometric::probability(sum),
             jnd: psychometric::jnd(sum, self.params.beta),
-            map: ErrorMap {
-                width: w,
-                height: h,
-                values: map,
-            },
+            map: reference.crop(map),
         })
     }
 
@@ -364,7 +384,8 @@ impl Vdp {
             .zip(&p.maskers)
             .map(|(b, m)| (b.w, b.h, m.as_slice()))
             .collect();
-        elevation_map(p.width, p.height, &maskers)
+        let (pw, ph) = p.padded_size();
+        p.crop(elevation_map(pw, ph, &maskers))
     }
 
     /// Qu & Meyer §4.2's visual masking map: `image` compared with `smooth`, its low-passed
@@ -387,7 +408,8 @@ impl Vdp {
             .iter()
             .map(|(w, h, m)| (*w, *h, m.as_slice()))
             .collect();
-        Ok(elevation_map(a.width, a.height, &maskers))
+        let (pw, ph) = a.padded_size();
+        Ok(a.crop(elevation_map(pw, ph, &maskers)))
     }
 }
 
@@ -395,7 +417,7 @@ impl Vdp {
 /// magnitudes `(band width, band height, values)`, band k at 1/2^k resolution, each band's
 /// elevations interpolated bilinearly between its sample centres (so a coarse band does not
 /// print its sampling grid into the map).
-fn elevation_map(w: usize, h: usize, maskers: &[(usize, usize, &[f32])]) -> ErrorMap {
+fn elevation_map(w: usize, h: usize, maskers: &[(usize, usize, &[f32])]) -> Vec<f32> {
     let mut out = vec![1.0f32; w * h];
     for (k, &(bw, bh, m)) in maskers.iter().enumerate() {
         let e: Vec<f32> = m.iter().map(|&v| threshold_elevation(v)).collect();
@@ -417,11 +439,7 @@ fn elevation_map(w: usize, h: usize, maskers: &[(usize, usize, &[f32])]) -> Erro
             }
         });
     }
-    ErrorMap {
-        width: w,
-        height: h,
-        values: out,
-    }
+    out
 }
 
 /// Centre frequency of band `k` at `ppd`, cycles per degree.
