@@ -113,14 +113,14 @@ pub fn measure(
         cfg.render.environment_rotation.0 as f32,
         cfg.render.environment_intensity.0 as f32,
     )?;
-    let reference = super::run::scene_for(&cfg, original.clone());
+    let reference = super::assets::scene_for(&cfg, original.clone());
     let cameras = cfg.render.rig.0.cameras(original, 1.0);
     let directions: Vec<glam::Vec3> = cameras.iter().take(3).map(|c| c.to_eye()).collect();
     let settings = cfg.render.settings();
     let mut rows = Vec::new();
     let originals = super::distance::OriginalProbes::new();
     for (name, lod) in lods {
-        let scene = super::run::scene_for(&cfg, lod.clone());
+        let scene = super::assets::scene_for(&cfg, lod.clone());
         let job = super::distance::DistanceJob {
             original: &reference,
             lod: &scene,

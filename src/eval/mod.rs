@@ -19,6 +19,7 @@
 //! run also writes `shard.json` (the config text, the shard and its cases) so a merge needs
 //! nothing but the folders.
 
+pub mod assets;
 pub mod cache;
 pub mod compare;
 pub mod config;
@@ -26,7 +27,6 @@ pub mod distance;
 pub mod export;
 pub mod gate;
 pub mod golden;
-pub mod golden_report;
 pub mod junit;
 mod manifest;
 pub mod out;

@@ -21,9 +21,10 @@ use std::sync::Arc;
 
 use rayon::prelude::*;
 
+use super::assets::{build_lods, scene_for};
 use super::config::{GltfExport, HeatmapChoice, MetricFamily};
 use super::distance::{self, DistanceJob};
-use super::plan::{AssetPlan, GenTarget, LodSource, Plan, Shard, case_id};
+use super::plan::{AssetPlan, LodSource, Plan, Shard, case_id};
 use super::score::Scorer;
 use super::tables::{LodInfo, MetricRow, Results, higher_is_worse, round7};
 use crate::backend::SceneRenderer;
@@ -32,8 +33,6 @@ use crate::mesh::{self, LoadOptions, Mesh, surface_distance};
 use crate::metric::{LinearImage, colormap};
 use crate::progress::Progress;
 use crate::raster::{self, RenderScene};
-use crate::scene::Scene;
-use crate::simplify::{self, Method};
 
 /// How to run.
 #[derive(Debug, Clone)]
@@ -590,105 +589,6 @@ fn search_distances(
         })
         .collect::<Result<Vec<_>>>()?;
     Ok(rows.into_iter().flatten().collect())
-}
-
-/// A scene of `mesh` with the config's lights, environment, background and ambient term.
-pub fn scene_for(cfg: &super::config::Config, mesh: Arc<Mesh>) -> RenderScene {
-    let mut s = Scene::new(mesh);
-    s.lights = cfg.render.scene_lights();
-    s.light_with(&cfg.render.lighting);
-    s.background = glam::Vec3::from_array(cfg.render.background.map(|c| c.0 as f32))
-        .map(crate::color::srgb_to_linear);
-    s.ambient = cfg.render.ambient.0 as f32;
-    RenderScene::new(s)
-}
-
-/// Load or generate the wanted LODs of an asset (a generated chain is built up to its last wanted
-/// step, since steps may start from the previous one).
-pub fn build_lods(
-    asset: &AssetPlan,
-    original: &Mesh,
-    wanted: &[bool],
-) -> Result<Vec<(String, Mesh, LodInfo)>> {
-    // The generated chain, computed once up to the last wanted step.
-    let generated: Vec<(Method, GenTarget)> = asset
-        .lods
-        .iter()
-        .filter_map(|l| match l.source {
-            LodSource::Generated { method, target, .. } => Some((method, target)),
-            LodSource::File(_) => None,
-        })
-        .collect();
-    let last = asset
-        .lods
-        .iter()
-        .zip(wanted)
-        .filter_map(|(l, w)| match l.source {
-            LodSource::Generated { step, .. } if *w => Some(step),
-            _ => None,
-        })
-        .max();
-    let mut chain = match (last, generated.first()) {
-        (Some(last), Some(&(method, _))) => {
-            let goals: Vec<_> = generated[..=last].iter().map(|g| g.1.goal()).collect();
-            simplify::chain_scaled(original, method, &goals, asset.meters_per_unit)?
-                .into_iter()
-                .map(Some)
-                .collect()
-        }
-        _ => Vec::new(),
-    };
-    let mut out = Vec::new();
-    for (lod, &want) in asset.lods.iter().zip(wanted) {
-        if !want {
-            continue;
-        }
-        let (mesh, source, error) = match &lod.source {
-            LodSource::File(path) => (
-                mesh::load(path, &LoadOptions::default())?,
-                path.display().to_string(),
-                None,
-            ),
-            LodSource::Generated {
-                method,
-                step,
-                target,
-            } => {
-                let l = chain[*step].take().expect("each step is taken once");
-                let what = match target {
-                    GenTarget::Ratio(r) => {
-                        format!("{} ratio {r} (chain step {})", method.name(), step + 1)
-                    }
-                    GenTarget::Error(e) => {
-                        format!("{} error {e} (chain step {})", method.name(), step + 1)
-                    }
-                    GenTarget::Distance(d) => {
-                        format!("{} distance {d} m (chain step {})", method.name(), step + 1)
-                    }
-                    GenTarget::Vertices(v) => {
-                        format!("{} {v} vertices (chain step {})", method.name(), step + 1)
-                    }
-                };
-                (l.mesh, what, l.error.map(round7))
-            }
-        };
-        let info = LodInfo {
-            asset: asset.name.clone(),
-            lod: lod.name.clone(),
-            triangles: mesh.triangle_count(),
-            original_triangles: original.triangle_count(),
-            source,
-            simplifier_error: error,
-            switch_m: lod.switch_m,
-            hausdorff: None,
-            mean_distance: None,
-            rms_distance: None,
-            hausdorff_relative: None,
-            mean_relative: None,
-        };
-        out.push((lod.name.clone(), mesh, info));
-    }
-    Ok(out)
 }
 
 /// Views of one LOD, worst first, by the first configured metric with a per-view value (FLIP if

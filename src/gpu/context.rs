@@ -44,15 +44,15 @@ pub struct Gpu {
     pub(crate) queue: wgpu::Queue,
     pub(crate) info: AdapterInfo,
     /// The renderer's pipelines, built on first use and shared by every scene.
-    render_pipelines: std::sync::OnceLock<super::render::Pipelines>,
+    render_pipelines: std::sync::OnceLock<super::pipelines::Pipelines>,
 }
 
 impl Gpu {
     /// The renderer's pipelines (compiled on the first call; the shaders depend only on the
     /// device, so every scene uses the same ones).
-    pub(crate) fn render_pipelines(&self) -> &super::render::Pipelines {
+    pub(crate) fn render_pipelines(&self) -> &super::pipelines::Pipelines {
         self.render_pipelines
-            .get_or_init(|| super::render::build_pipelines(self))
+            .get_or_init(|| super::pipelines::build(&self.device))
     }
 
     /// Open the best adapter. `Err(Error::Usage(NO_ADAPTER…))` when there is none.
@@ -207,21 +207,7 @@ impl Gpu {
 
     /// A compute pipeline from WGSL source with entry point `main` and an inferred layout.
     pub(crate) fn compute_pipeline(&self, label: &str, source: &str) -> wgpu::ComputePipeline {
-        let module = self
-            .device
-            .create_shader_module(wgpu::ShaderModuleDescriptor {
-                label: Some(label),
-                source: wgpu::ShaderSource::Wgsl(source.into()),
-            });
-        self.device
-            .create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-                label: Some(label),
-                layout: None,
-                module: &module,
-                entry_point: Some("main"),
-                compilation_options: Default::default(),
-                cache: None,
-            })
+        super::pipelines::compute_pipeline(&self.device, label, source)
     }
 
     /// Run `pipeline` over `groups` workgroups with `buffers` bound at bindings 0, 1, … of group 0.

@@ -10,6 +10,8 @@
 //!   anti-aliasing sample, the projection shifted so that the CPU's sample position falls on the
 //!   pixel centre; writes triangle id and depth) and `shaders/shade.wgsl` (a compute pass: the
 //!   CPU's resolve and shading models line for line, with its mip pyramids and trilinear formula).
+//! - `pipelines.rs` — the renderer's two passes as pipelines, built from the device alone (the
+//!   device caches them, the renderer records with them).
 //! - `metric.rs` — MSE (`shaders/mse.wgsl`) and ꟻLIP (`shaders/flip_*.wgsl`, one pass per file),
 //!   returning the CPU's [`MseScore`](crate::metric::mse::MseScore) and
 //!   [`FlipScore`](crate::metric::flip::FlipScore).
@@ -26,6 +28,7 @@
 
 mod context;
 mod metric;
+mod pipelines;
 mod render;
 
 pub use context::{AdapterInfo, Gpu, NO_ADAPTER};

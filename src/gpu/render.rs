@@ -27,6 +27,7 @@ use bytemuck::{Pod, Zeroable};
 use glam::{Vec3, Vec4};
 
 use super::Gpu;
+use super::pipelines::{DEPTH_FORMAT, ID_FORMAT};
 use crate::error::{Error, Result};
 use crate::raster::RenderScene;
 use crate::raster::{
@@ -35,13 +36,8 @@ use crate::raster::{
 };
 use crate::scene::Camera;
 
-const VISIBILITY_WGSL: &str = include_str!("shaders/visibility.wgsl");
-const SHADE_WGSL: &str = include_str!("shaders/shade.wgsl");
-
 /// Floats per vertex record (shade.wgsl's and visibility.wgsl's `VSTRIDE`).
 const VSTRIDE: usize = 18;
-const ID_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Uint;
-const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
 
 /// Lights a GPU frame can hold (shade.wgsl's `MAX_LIGHTS`).
 const MAX_LIGHTS: usize = 8;
@@ -137,16 +133,6 @@ struct Mvp {
 struct Jitter {
     ndc: [f32; 2],
     pad: [f32; 2],
-}
-
-/// The visibility pipelines (with and without back-face culling) and the shading pipeline. They
-/// depend only on the device: built once per [`Gpu`] ([`Gpu::render_pipelines`]) and shared by
-/// every scene (eval uploads one scene per LOD).
-#[derive(Debug)]
-pub(crate) struct Pipelines {
-    visibility: wgpu::RenderPipeline,
-    visibility_culled: wgpu::RenderPipeline,
-    shade: wgpu::ComputePipeline,
 }
 
 /// A scene on the GPU.
@@ -634,59 +620,6 @@ fn sample_target(
         usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
         view_formats: &[],
     })
-}
-
-/// The visibility pipelines and the shading pipeline.
-pub(crate) fn build_pipelines(gpu: &Gpu) -> Pipelines {
-    let device = &gpu.device;
-    let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-        label: Some("visibility.wgsl"),
-        source: wgpu::ShaderSource::Wgsl(VISIBILITY_WGSL.into()),
-    });
-    let visibility = |cull: Option<wgpu::Face>| {
-        device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-            label: Some("visibility"),
-            layout: None,
-            vertex: wgpu::VertexState {
-                module: &module,
-                entry_point: Some("vs"),
-                compilation_options: Default::default(),
-                buffers: &[],
-            },
-            primitive: wgpu::PrimitiveState {
-                topology: wgpu::PrimitiveTopology::TriangleList,
-                front_face: wgpu::FrontFace::Ccw,
-                cull_mode: cull,
-                ..Default::default()
-            },
-            depth_stencil: Some(wgpu::DepthStencilState {
-                format: DEPTH_FORMAT,
-                depth_write_enabled: Some(true),
-                // Strict: on equal depth the earlier triangle stays, as on the CPU.
-                depth_compare: Some(wgpu::CompareFunction::Less),
-                stencil: Default::default(),
-                bias: Default::default(),
-            }),
-            multisample: Default::default(),
-            fragment: Some(wgpu::FragmentState {
-                module: &module,
-                entry_point: Some("fs"),
-                compilation_options: Default::default(),
-                targets: &[Some(wgpu::ColorTargetState {
-                    format: ID_FORMAT,
-                    blend: None,
-                    write_mask: wgpu::ColorWrites::ALL,
-                })],
-            }),
-            multiview_mask: None,
-            cache: None,
-        })
-    };
-    Pipelines {
-        visibility: visibility(None),
-        visibility_culled: visibility(Some(wgpu::Face::Back)),
-        shade: gpu.compute_pipeline("shade.wgsl", SHADE_WGSL),
-    }
 }
 
 /// shade.wgsl's `Slot` for a prepared slot placed at levels `at` (first, count).

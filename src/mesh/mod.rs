@@ -24,7 +24,6 @@
 mod bounds;
 pub mod edit;
 mod gltf;
-mod gltf_check;
 mod gltf_material;
 mod incidence;
 mod material;

@@ -70,8 +70,38 @@ pub fn shared_models() -> Option<PathBuf> {
     p.join("MANIFEST.md").exists().then_some(p)
 }
 
-/// As [`lodeval`], but the run must end within `seconds`: a hang fails the test (the child is
-/// killed) instead of stalling the suite until CI's limit.
+/// How many times longer than planned a test waits before it calls a run a hang:
+/// `LODEVAL_TEST_TIME_SCALE` (default 1; raise it on a slow or shared machine).
+pub fn time_scale() -> f64 {
+    std::env::var("LODEVAL_TEST_TIME_SCALE")
+        .ok()
+        .and_then(|v| v.parse::<f64>().ok())
+        .filter(|s| s.is_finite() && *s >= 1.0)
+        .unwrap_or(1.0)
+}
+
+/// A wall-clock limit for work planned to take at most `seconds` on an idle machine: 5× that,
+/// times [`time_scale`]. For waits that cannot watch a process's CPU time.
+pub fn hang_limit(seconds: u64) -> std::time::Duration {
+    std::time::Duration::from_secs_f64(5.0 * seconds as f64 * time_scale())
+}
+
+/// CPU seconds (user + system, all threads) process `pid` has used, from `/proc/PID/stat`
+/// (fields 14 and 15, in clock ticks of 1/100 s on Linux); `None` where there is no `/proc`.
+fn cpu_seconds(pid: u32) -> Option<f64> {
+    let stat = std::fs::read_to_string(format!("/proc/{pid}/stat")).ok()?;
+    // The command name (field 2) is in parentheses and may hold spaces: count from after it.
+    let fields: Vec<&str> = stat.rsplit_once(')')?.1.split_whitespace().collect();
+    let ticks: f64 = fields.get(11)?.parse::<f64>().ok()? + fields.get(12)?.parse::<f64>().ok()?;
+    Some(ticks / 100.0)
+}
+
+/// As [`lodeval`], but a hang fails the test (the child is killed) instead of stalling the suite
+/// until CI's limit, and a slow machine does not. `seconds` is what the run may take on an idle
+/// machine; the watchdog judges progress, not wall time: the child may use `seconds` of CPU per
+/// core (a busy loop that never ends runs out of it however loaded the machine is), and a child
+/// that uses no CPU (a deadlock) is stopped by the wall-clock [`hang_limit`]. Both scale with
+/// [`time_scale`].
 #[track_caller]
 pub fn lodeval_within<I, S>(seconds: u64, args: I) -> Run
 where
@@ -100,15 +130,27 @@ where
     };
     let stdout = drain(Box::new(child.stdout.take().unwrap()));
     let stderr = drain(Box::new(child.stderr.take().unwrap()));
-    let deadline = Instant::now() + Duration::from_secs(seconds);
+    let cores = std::thread::available_parallelism().map_or(1, |n| n.get()) as f64;
+    let cpu_budget = seconds as f64 * cores * time_scale();
+    let deadline = Instant::now() + hang_limit(seconds);
     let status = loop {
         if let Some(status) = child.try_wait().unwrap() {
             break status;
         }
-        if Instant::now() > deadline {
+        let used = cpu_seconds(child.id());
+        let why = if used.is_some_and(|c| c > cpu_budget) {
+            Some(format!("used more than {cpu_budget:.0} s of CPU"))
+        } else if Instant::now() > deadline {
+            Some(format!("did not finish within {:?}", hang_limit(seconds)))
+        } else {
+            None
+        };
+        if let Some(why) = why {
             let _ = child.kill();
             let _ = child.wait();
-            panic!("lodeval {args:?} did not finish within {seconds} s (a hang)");
+            panic!(
+                "lodeval {args:?} {why} (a hang; set LODEVAL_TEST_TIME_SCALE on a slow machine)"
+            );
         }
         std::thread::sleep(Duration::from_millis(20));
     };
@@ -137,4 +179,21 @@ pub fn files(dir: &Path) -> std::collections::BTreeMap<PathBuf, Vec<u8>> {
         }
     }
     out
+}
+
+#[test]
+fn the_hang_watchdog_sees_cpu_time_where_there_is_proc() {
+    // `lodeval_within` judges a run by the CPU it used, so a loaded machine cannot fail it; that
+    // needs /proc's clock to move with work done.
+    let Some(before) = cpu_seconds(std::process::id()) else {
+        return; // no /proc (not Linux): the wall-clock limit alone applies
+    };
+    let start = std::time::Instant::now();
+    let mut x = 0u64;
+    while start.elapsed() < std::time::Duration::from_millis(300) {
+        x = std::hint::black_box(x.wrapping_mul(6364136223846793005).wrapping_add(1));
+    }
+    let after = cpu_seconds(std::process::id()).unwrap();
+    assert!(after - before >= 0.1, "{before} → {after}");
+    assert!(hang_limit(20) >= std::time::Duration::from_secs(100));
 }

@@ -352,7 +352,8 @@ fn apply_json(seed: &serde_json::Value, muts: &[JsonMutation]) -> serde_json::Va
     v
 }
 
-/// Load `bytes` as `name` on a thread; a load that does not end within 20 s is a hang.
+/// Load `bytes` as `name` on a thread; a load that does not end within the hang limit for 20 s
+/// of work is a hang.
 fn load_within(name: &str, bytes: Vec<u8>) {
     let dir = tempfile::tempdir().unwrap();
     let p = dir.path().join(name);
@@ -363,10 +364,11 @@ fn load_within(name: &str, bytes: Vec<u8>) {
         let _ = load_unguarded(&path, &LoadOptions::DEFAULT);
         let _ = tx.send(());
     });
-    match rx.recv_timeout(std::time::Duration::from_secs(20)) {
+    let limit = crate::common::hang_limit(20);
+    match rx.recv_timeout(limit) {
         Ok(()) => {}
         Err(std::sync::mpsc::RecvTimeoutError::Timeout) => panic!(
-            "loading did not end within 20 s (a hang):\n{}",
+            "loading did not end within {limit:?} (a hang):\n{}",
             String::from_utf8_lossy(&bytes)
         ),
         // The thread panicked: proptest reports the panic message it printed.

@@ -34,12 +34,12 @@ fn spawn(args: &[&str]) -> Child {
         .unwrap()
 }
 
-/// Wait (at most a minute) until `cond` holds.
+/// Wait until `cond` holds (at most the hang limit for a minute's work).
 fn wait_for(what: &str, cond: impl Fn() -> bool) {
     let start = Instant::now();
     while !cond() {
         assert!(
-            start.elapsed() < Duration::from_secs(60),
+            start.elapsed() < crate::common::hang_limit(60),
             "timed out waiting for {what}"
         );
         std::thread::sleep(Duration::from_millis(20));

@@ -9,7 +9,7 @@ use std::path::Path;
 
 use base64::Engine as _;
 
-use super::golden::{GoldenOutcome, GoldenStatus};
+use super::{GoldenOutcome, GoldenStatus};
 use crate::error::Result;
 
 /// A PNG file as a data URI (an empty string when it cannot be read: the cell says so).

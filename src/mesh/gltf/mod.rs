@@ -13,10 +13,12 @@ use std::path::Path;
 
 use glam::{Mat3, Mat4, Vec2, Vec3};
 
-use super::{
+mod check;
+
+use crate::error::{Error, Location, Result};
+use crate::mesh::{
     FileLight, Format, LightKind, LoadOptions, Material, MeshData, Source, SourceNode, read_file,
 };
-use crate::error::{Error, Location, Result};
 
 pub(super) const REEXPORT: &str =
     "re-export the glTF file (e.g. from Blender) or check it with the Khronos glTF validator";
@@ -43,7 +45,7 @@ struct Builder {
 /// Load a glTF or GLB file.
 pub(crate) fn load(path: &Path, options: &LoadOptions) -> Result<MeshData> {
     let bytes = read_file(path)?;
-    super::gltf_check::check_glb_header(path, &bytes)?;
+    check::check_glb_header(path, &bytes)?;
     let invalid =
         |e: gltf::Error| Error::input(path, format!("not a valid glTF file: {e}"), REEXPORT);
     let gltf::Gltf { document, blob } =
@@ -51,7 +53,7 @@ pub(crate) fn load(path: &Path, options: &LoadOptions) -> Result<MeshData> {
     let root = document.into_json();
     // Wrong accessor types first: they say more than the byte ranges they make wrong.
     check_primitive_accessors(path, &root)?;
-    super::gltf_check::check(path, &root)?;
+    check::check(path, &root)?;
     let document = gltf::Document::from_json(root).map_err(invalid)?;
     let base = path.parent().unwrap_or(Path::new("."));
     // Every file the document reads, besides itself (never to be overwritten by an output).
@@ -109,14 +111,14 @@ pub(crate) fn load(path: &Path, options: &LoadOptions) -> Result<MeshData> {
     })?;
 
     // Materials, every slot, decoding each used image once per colour space.
-    let mut images = super::gltf_material::Images::new(path, base, &buffers, options);
+    let mut images = crate::mesh::gltf_material::Images::new(path, base, &buffers, options);
     let mut materials = Vec::new();
     for (mi, m) in document.materials().enumerate() {
-        materials.push(super::gltf_material::load(&m, mi, &mut images)?);
+        materials.push(crate::mesh::gltf_material::load(&m, mi, &mut images)?);
     }
     let mut warnings = std::mem::take(&mut images.warnings);
     let default_id = materials.len() as u32;
-    super::gltf_check::check_tex_coords(path, document.as_json())?;
+    check::check_tex_coords(path, document.as_json())?;
 
     // Geometry: walk the scene graph, accumulating world transforms.
     let mut b = Builder::default();

@@ -6,7 +6,7 @@
 //! output folder (`golden/ASSET/LOD/view-NN-actual.png`, `-diff.png`) and the exact bless command
 //! is printed. `--bless` writes new goldens and refuses when the `CI` environment variable is set.
 //!
-//! Every run also writes `golden/report.html` (`golden_report.rs`): the mismatches first, each as
+//! Every run also writes `golden/report.html` (`golden/report.rs`): the mismatches first, each as
 //! expected | actual | diff with a slider between expected and actual. `--bless ASSET[/LOD[/VIEW]]`
 //! blesses only the images a filter names and compares the rest, as insta and Playwright accept
 //! one snapshot at a time; the mismatches' `-actual.png` files are the pending ones.
@@ -17,9 +17,11 @@
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
-use super::config::{config_dir, resolve, stem};
-use super::plan::Plan;
+mod report;
+
 use crate::error::{Error, Result};
+use crate::eval::config::{config_dir, resolve, stem};
+use crate::eval::plan::Plan;
 use crate::mesh::{self, LoadOptions, Mesh};
 use crate::metric::flip::Flip;
 use crate::metric::{LinearImage, colormap, pool};
@@ -144,7 +146,7 @@ pub fn run(plan: &Plan, bless: &Bless, ci: bool, out_dir: &Path) -> Result<Golde
         for f in filters {
             let parts: Vec<&str> = f.split('/').collect();
             let asset = plan.assets.iter().find(|a| a.name == parts[0]);
-            let lod_ok = |a: &super::plan::AssetPlan| {
+            let lod_ok = |a: &crate::eval::plan::AssetPlan| {
                 parts.get(1).is_none_or(|l| {
                     *l == "original" || (cfg.golden.lods && a.lods.iter().any(|x| x.name == *l))
                 })
@@ -166,7 +168,7 @@ pub fn run(plan: &Plan, bless: &Bless, ci: bool, out_dir: &Path) -> Result<Golde
     // Mismatch images of an earlier run go first, so what is left is this run's.
     let mut inputs = plan.input_files();
     inputs.push(dir.clone());
-    let run_dir = super::out::prepare(out_dir, super::out::GOLDEN, &inputs)?;
+    let run_dir = crate::eval::out::prepare(out_dir, crate::eval::out::GOLDEN, &inputs)?;
     let settings = cfg.render.settings();
     let flip = Flip::new(cfg.viewing.viewing().ppd() as f32);
     let mut outcome = GoldenOutcome::default();
@@ -176,12 +178,12 @@ pub fn run(plan: &Plan, bless: &Bless, ci: bool, out_dir: &Path) -> Result<Golde
         let mut meshes: Vec<(String, Arc<Mesh>)> = vec![("original".into(), original.clone())];
         if cfg.golden.lods {
             let all = vec![true; asset.lods.len()];
-            for (name, m, _) in super::run::build_lods(asset, &original, &all)? {
+            for (name, m, _) in crate::eval::assets::build_lods(asset, &original, &all)? {
                 meshes.push((name, Arc::new(m)));
             }
         }
         for (name, m) in meshes {
-            let scene = super::run::scene_for(cfg, m);
+            let scene = crate::eval::assets::scene_for(cfg, m);
             for (v, cam) in cameras.iter().enumerate() {
                 let rel = Path::new(&asset.name)
                     .join(&name)
@@ -237,7 +239,7 @@ pub fn run(plan: &Plan, bless: &Bless, ci: bool, out_dir: &Path) -> Result<Golde
     let report = out_dir.join("golden").join("report.html");
     crate::io::write_atomic(
         &report,
-        super::golden_report::render(&plan.config_path, &outcome)?.as_bytes(),
+        report::render(&plan.config_path, &outcome)?.as_bytes(),
     )?;
     outcome.report = Some(report);
     run_dir.seal()?;
@@ -250,7 +252,7 @@ fn compare(
     flip: &Flip,
     golden_path: &Path,
     actual: &image::RgbImage,
-    cfg: &super::config::Config,
+    cfg: &crate::eval::config::Config,
 ) -> Result<Option<(String, Option<image::RgbImage>)>> {
     if !golden_path.exists() {
         return Ok(Some(("no golden image".into(), None)));

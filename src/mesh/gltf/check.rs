@@ -12,7 +12,7 @@ use std::path::Path;
 
 use gltf::json::validation::Checked;
 
-use super::gltf::REEXPORT;
+use super::REEXPORT;
 use crate::error::{Error, Location, Result};
 
 /// Run every structural check on `root`.
