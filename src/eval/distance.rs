@@ -488,32 +488,7 @@ fn search_probing(
     };
     let mut rows = Vec::new();
     for (criterion, visible) in &criteria {
-        // Bracket: double from the smallest probe until visible or at the limit.
-        let mut lo = 0u32; // largest diameter known invisible (0: none yet)
-        let mut hi = None; // smallest diameter known visible
-        let mut d = min_d;
-        loop {
-            if visible(&probe(d, false)?) {
-                hi = Some(d);
-                break;
-            }
-            lo = d;
-            if d >= max_d {
-                break;
-            }
-            d = (d * 2).min(max_d);
-        }
-        // Bisect on log(diameter) to 2 %.
-        if let Some(mut h) = hi {
-            while lo > 0 && (h as f64) > lo as f64 * 1.02 && h - lo > 1 {
-                let mid = ((lo as f64 * h as f64).sqrt().round() as u32).clamp(lo + 1, h - 1);
-                if visible(&probe(mid, false)?) {
-                    h = mid;
-                } else {
-                    lo = mid;
-                }
-            }
-        }
+        let (lo, hi) = threshold_diameter(min_d, max_d, |d| Ok(visible(&probe(d, false)?)))?;
         // Imperceptible beyond the distance of the largest invisible diameter. When the search hit a
         // limit (visible at the smallest probe, or invisible up to the largest) it is a bound.
         let bound = match (hi, lo) {
@@ -556,6 +531,42 @@ fn search_probing(
         })
         .collect();
     Ok((rows, probed))
+}
+
+/// The search over on-screen diameters from `min_d` to `max_d` pixels for where `visible` turns
+/// true: double from the smallest until visible or at the limit, then bisect on log(diameter) to
+/// 2 %. Returns the largest diameter known invisible (0: none) and the smallest known visible
+/// (`None`: invisible up to `max_d`).
+fn threshold_diameter(
+    min_d: u32,
+    max_d: u32,
+    mut visible: impl FnMut(u32) -> Result<bool>,
+) -> Result<(u32, Option<u32>)> {
+    let mut lo = 0u32;
+    let mut hi = None;
+    let mut d = min_d;
+    loop {
+        if visible(d)? {
+            hi = Some(d);
+            break;
+        }
+        lo = d;
+        if d >= max_d {
+            break;
+        }
+        d = (d * 2).min(max_d);
+    }
+    if let Some(mut h) = hi {
+        while lo > 0 && (h as f64) > lo as f64 * 1.02 && h - lo > 1 {
+            let mid = ((lo as f64 * h as f64).sqrt().round() as u32).clamp(lo + 1, h - 1);
+            if visible(mid)? {
+                h = mid;
+            } else {
+                lo = mid;
+            }
+        }
+    }
+    Ok((lo, hi))
 }
 
 /// The smallest and largest on-screen diameters searched, pixels: [`MIN_PROBE`] to

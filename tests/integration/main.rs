@@ -42,6 +42,7 @@ mod cli;
 mod common;
 mod eval;
 mod export;
+mod function_length;
 mod fuzz;
 #[cfg(feature = "gpu")]
 mod gpu;

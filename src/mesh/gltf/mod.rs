@@ -56,52 +56,8 @@ pub(crate) fn load(path: &Path, options: &LoadOptions) -> Result<MeshData> {
     check::check(path, &root)?;
     let document = gltf::Document::from_json(root).map_err(invalid)?;
     let base = path.parent().unwrap_or(Path::new("."));
-    // Every file the document reads, besides itself (never to be overwritten by an output).
-    let mut files = vec![path.to_path_buf()];
-    for buffer in document.buffers() {
-        if let gltf::buffer::Source::Uri(uri) = buffer.source()
-            && !uri.starts_with("data:")
-        {
-            files.push(base.join(uri));
-        }
-    }
-    for image in document.images() {
-        if let gltf::image::Source::Uri { uri, .. } = image.source()
-            && !uri.starts_with("data:")
-        {
-            files.push(base.join(uri));
-        }
-    }
-    // Name a missing external buffer ourselves; the import error would only say "not found".
-    for buffer in document.buffers() {
-        if let gltf::buffer::Source::Uri(uri) = buffer.source() {
-            let file = base.join(uri);
-            if uri.starts_with("data:") || uri.contains('%') {
-                continue;
-            }
-            let element = Location::Element(format!("buffer {}", buffer.index()));
-            let fix = "put the .bin file next to the .gltf, or re-export as a single .glb";
-            if !file.exists() {
-                return Err(Error::input_at(
-                    path,
-                    element,
-                    format!("its data file '{uri}' is missing"),
-                    fix,
-                ));
-            }
-            // A FIFO or /dev/zero named as a buffer would block or read without end.
-            if let Err(Error::Input { problem, .. }) =
-                crate::io::check_input(&file, "buffer", crate::limits::MESH_BYTES, fix)
-            {
-                return Err(Error::input_at(
-                    path,
-                    element,
-                    format!("'{uri}': {problem}"),
-                    fix,
-                ));
-            }
-        }
-    }
+    let files = input_files(path, base, &document);
+    check_external_buffers(path, base, &document)?;
     let buffers = gltf::import_buffers(&document, Some(base), blob).map_err(|e| {
         Error::input(
             path,
@@ -120,8 +76,85 @@ pub(crate) fn load(path: &Path, options: &LoadOptions) -> Result<MeshData> {
     let default_id = materials.len() as u32;
     check::check_tex_coords(path, document.as_json())?;
 
-    // Geometry: walk the scene graph, accumulating world transforms.
     let mut b = Builder::default();
+    walk_scene(path, &document, &buffers, default_id, &mut b)?;
+    if b.material_ids.contains(&default_id) {
+        materials.push(Material::default_material());
+    }
+    warnings.append(&mut b.warnings);
+    if b.color_alpha {
+        warnings.push(
+            "COLOR_0 has alpha below 1; lodeval keeps vertex colours as RGB (the alpha is not \
+             rendered or exported)"
+                .into(),
+        );
+    }
+    Ok(b.finish(path, files, materials, warnings))
+}
+
+/// Every file the document reads, besides itself (never to be overwritten by an output).
+fn input_files(path: &Path, base: &Path, document: &gltf::Document) -> Vec<std::path::PathBuf> {
+    let mut files = vec![path.to_path_buf()];
+    for buffer in document.buffers() {
+        if let gltf::buffer::Source::Uri(uri) = buffer.source()
+            && !uri.starts_with("data:")
+        {
+            files.push(base.join(uri));
+        }
+    }
+    for image in document.images() {
+        if let gltf::image::Source::Uri { uri, .. } = image.source()
+            && !uri.starts_with("data:")
+        {
+            files.push(base.join(uri));
+        }
+    }
+    files
+}
+
+/// Name a missing or unreadable external buffer ourselves: the import error would only say "not
+/// found", and a FIFO or /dev/zero named as a buffer would block or read without end.
+fn check_external_buffers(path: &Path, base: &Path, document: &gltf::Document) -> Result<()> {
+    for buffer in document.buffers() {
+        if let gltf::buffer::Source::Uri(uri) = buffer.source() {
+            let file = base.join(uri);
+            if uri.starts_with("data:") || uri.contains('%') {
+                continue;
+            }
+            let element = Location::Element(format!("buffer {}", buffer.index()));
+            let fix = "put the .bin file next to the .gltf, or re-export as a single .glb";
+            if !file.exists() {
+                return Err(Error::input_at(
+                    path,
+                    element,
+                    format!("its data file '{uri}' is missing"),
+                    fix,
+                ));
+            }
+            if let Err(Error::Input { problem, .. }) =
+                crate::io::check_input(&file, "buffer", crate::limits::MESH_BYTES, fix)
+            {
+                return Err(Error::input_at(
+                    path,
+                    element,
+                    format!("'{uri}': {problem}"),
+                    fix,
+                ));
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Geometry: walk the default scene's graph (else the first scene's; with no scene, every mesh
+/// untransformed), accumulating world transforms, into `b`.
+fn walk_scene(
+    path: &Path,
+    document: &gltf::Document,
+    buffers: &[gltf::buffer::Data],
+    default_id: u32,
+    b: &mut Builder,
+) -> Result<()> {
     let roots: Vec<(gltf::Node, Mat4)> = match document
         .default_scene()
         .or_else(|| document.scenes().next())
@@ -131,7 +164,7 @@ pub(crate) fn load(path: &Path, options: &LoadOptions) -> Result<MeshData> {
     };
     if roots.is_empty() {
         for mesh in document.meshes() {
-            add_mesh(path, &mut b, &mesh, Mat4::IDENTITY, &buffers, default_id)?;
+            add_mesh(path, b, &mesh, Mat4::IDENTITY, buffers, default_id)?;
         }
     }
     let mut stack = roots;
@@ -139,7 +172,7 @@ pub(crate) fn load(path: &Path, options: &LoadOptions) -> Result<MeshData> {
     while let Some((node, parent)) = stack.pop() {
         let world = parent * Mat4::from_cols_array_2d(&node.transform().matrix());
         if let Some(mesh) = node.mesh() {
-            add_mesh(path, &mut b, &mesh, world, &buffers, default_id)?;
+            add_mesh(path, b, &mesh, world, buffers, default_id)?;
             b.nodes.push(SourceNode {
                 name: node
                     .name()
@@ -156,44 +189,47 @@ pub(crate) fn load(path: &Path, options: &LoadOptions) -> Result<MeshData> {
             stack.push((child, world));
         }
     }
-    if b.material_ids.contains(&default_id) {
-        materials.push(Material::default_material());
+    Ok(())
+}
+
+impl Builder {
+    /// The mesh data of everything accumulated (an attribute only where some vertex had it).
+    fn finish(
+        self,
+        path: &Path,
+        files: Vec<std::path::PathBuf>,
+        materials: Vec<Material>,
+        warnings: Vec<String>,
+    ) -> MeshData {
+        let b = self;
+        let has_uv = b.uvs.iter().any(Option::is_some);
+        let has_uv1 = b.uvs1.iter().any(Option::is_some);
+        let has_c = b.colors.iter().any(Option::is_some);
+        let file_faces = b.triangles.len();
+        MeshData {
+            normals: (!b.any_without_normals)
+                .then(|| b.normals.iter().map(|n| n.unwrap_or(Vec3::ZERO)).collect()),
+            uvs: has_uv.then(|| b.uvs.iter().map(|u| u.unwrap_or(Vec2::ZERO)).collect()),
+            uvs1: has_uv1.then(|| b.uvs1.iter().map(|u| u.unwrap_or(Vec2::ZERO)).collect()),
+            lights: b.lights,
+            colors: has_c.then(|| b.colors.iter().map(|c| c.unwrap_or(Vec3::ONE)).collect()),
+            positions: b.positions,
+            triangles: b.triangles,
+            material_ids: b.material_ids,
+            materials,
+            source: Source {
+                path: path.to_path_buf(),
+                format: Format::Gltf,
+                file_vertices: b.file_vertices,
+                file_faces,
+                file_unreferenced: 0,
+                edited: false,
+                files,
+                nodes: b.nodes,
+            },
+            warnings,
+        }
     }
-    warnings.append(&mut b.warnings);
-    if b.color_alpha {
-        warnings.push(
-            "COLOR_0 has alpha below 1; lodeval keeps vertex colours as RGB (the alpha is not \
-             rendered or exported)"
-                .into(),
-        );
-    }
-    let has_uv = b.uvs.iter().any(Option::is_some);
-    let has_uv1 = b.uvs1.iter().any(Option::is_some);
-    let has_c = b.colors.iter().any(Option::is_some);
-    let file_faces = b.triangles.len();
-    Ok(MeshData {
-        normals: (!b.any_without_normals)
-            .then(|| b.normals.iter().map(|n| n.unwrap_or(Vec3::ZERO)).collect()),
-        uvs: has_uv.then(|| b.uvs.iter().map(|u| u.unwrap_or(Vec2::ZERO)).collect()),
-        uvs1: has_uv1.then(|| b.uvs1.iter().map(|u| u.unwrap_or(Vec2::ZERO)).collect()),
-        lights: b.lights,
-        colors: has_c.then(|| b.colors.iter().map(|c| c.unwrap_or(Vec3::ONE)).collect()),
-        positions: b.positions,
-        triangles: b.triangles,
-        material_ids: b.material_ids,
-        materials,
-        source: Source {
-            path: path.to_path_buf(),
-            format: Format::Gltf,
-            file_vertices: b.file_vertices,
-            file_faces,
-            file_unreferenced: 0,
-            edited: false,
-            files,
-            nodes: b.nodes,
-        },
-        warnings,
-    })
 }
 
 /// Check that every primitive names accessors that exist and have types lodeval reads. The `gltf`

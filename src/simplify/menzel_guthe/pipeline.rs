@@ -307,35 +307,11 @@ pub fn run(
     adj.allow_non_manifold_collapses();
     let base = adj.clone();
     let diagonal = mesh.aabb().diagonal() as f64;
-    let mut cost = QemCost::with_attributes(&adj, diagonal);
     let original = Original::new(mesh, &adj);
     let original_positions = adj.positions.clone();
     let materials = Materials::of(mesh);
     let silhouette = Silhouette::PAPER;
-    let mut attached = Attached::new(adj.positions.len());
-    let mut version = vec![0u32; adj.positions.len()];
-    let initial: Vec<Entry> = {
-        let (adj, cost, version, silhouette) = (&adj, &cost, &version, &silhouette);
-        let n = adj.positions.len() as u32;
-        let chunks: Vec<Vec<Entry>> = (0..n.div_ceil(512))
-            .into_par_iter()
-            .map(|c| {
-                let mut out = Vec::new();
-                for u in c * 512..((c + 1) * 512).min(n) {
-                    for v in adj.ring(u) {
-                        if v > u
-                            && let Some(e) = entry(adj, cost, silhouette, version, u, v)
-                        {
-                            out.push(e);
-                        }
-                    }
-                }
-                out
-            })
-            .collect();
-        chunks.concat()
-    };
-    let mut heap = RadixQueue::from_vec(initial);
+    let mut state = Loop::new(adj, diagonal, silhouette);
     let tests = Tests {
         original: &original,
         original_positions: &original_positions,
@@ -344,49 +320,118 @@ pub fn run(
         silhouette: &silhouette,
         global,
     };
-    let mut counts = Counts::default();
-    let mut collapses: Vec<Collapse> = Vec::new();
-    let mut measured = Vec::new();
-    let mut running = 0.0f64;
-    let mut ring = Local::new();
-    // The last measured distance of each postponed edge (looked up, never iterated).
-    let mut measured_before: std::collections::HashMap<(u32, u32), u32> = Default::default();
     let block = engine.block.max(1);
     let setup = start.elapsed().as_secs_f64();
-    'outer: loop {
+    loop {
         if stop.triangles.is_some()
             && stop.distance.is_none()
-            && stop.triangles_reached(adj.triangle_count())
+            && stop.triangles_reached(state.adj.triangle_count())
         {
             break;
         }
-        // A block of current heads, each edge once.
+        let (heads, stopped) = state.take_block(block, &stop);
+        if heads.is_empty() {
+            break;
+        }
+        let accepted = state.test_block(heads, &tests, engine.perception);
+        if state.apply(accepted, &stop) || stopped {
+            break;
+        }
+    }
+    Outcome {
+        progressive: Progressive {
+            base,
+            collapses: state.collapses,
+            last: state.adj,
+        },
+        measured: state.measured,
+        counts: state.counts,
+        seconds: (setup, start.elapsed().as_secs_f64() - setup),
+    }
+}
+
+/// A collapse a block's tests accepted: its measured distance, its entry and where it goes.
+type Accepted = (f64, Entry, Box<Proposal>);
+
+/// The loop's state: the mesh as collapsed so far and everything that follows it.
+struct Loop {
+    adj: Adjacency,
+    cost: QemCost,
+    silhouette: Silhouette,
+    heap: RadixQueue<Entry>,
+    /// Per vertex, bumped by every collapse that moves it (stale entries carry an old sum).
+    version: Vec<u32>,
+    attached: Attached,
+    counts: Counts,
+    collapses: Vec<Collapse>,
+    measured: Vec<f64>,
+    /// The largest priority applied so far: each collapse's recorded split distance.
+    running: f64,
+    ring: Local<u32>,
+    /// The last measured distance of each postponed edge (looked up, never iterated).
+    measured_before: std::collections::HashMap<(u32, u32), u32>,
+}
+
+impl Loop {
+    /// The state before the first collapse, with every edge queued at the quadric's estimate.
+    fn new(adj: Adjacency, diagonal: f64, silhouette: Silhouette) -> Loop {
+        let cost = QemCost::with_attributes(&adj, diagonal);
+        let version = vec![0u32; adj.positions.len()];
+        let heap = RadixQueue::from_vec(initial_entries(&adj, &cost, &silhouette, &version));
+        Loop {
+            attached: Attached::new(adj.positions.len()),
+            adj,
+            cost,
+            silhouette,
+            heap,
+            version,
+            counts: Counts::default(),
+            collapses: Vec::new(),
+            measured: Vec::new(),
+            running: 0.0,
+            ring: Local::new(),
+            measured_before: Default::default(),
+        }
+    }
+
+    /// Up to `block` current queue heads, each edge once; `true` when a head was beyond the goal
+    /// (the loop ends after this block).
+    fn take_block(&mut self, block: usize, stop: &Stop) -> (Vec<Entry>, bool) {
         let mut heads: Vec<Entry> = Vec::with_capacity(block);
-        let mut stopped = false;
         while heads.len() < block {
-            let Some(e) = heap.pop(|e| e.current(&version)) else {
+            let Some(e) = self.heap.pop(|e| e.current(&self.version)) else {
                 break;
             };
-            if stop.distance_reached(e.distance()) && stop.triangles_reached(adj.triangle_count()) {
-                stopped = true;
-                break;
+            if stop.distance_reached(e.distance())
+                && stop.triangles_reached(self.adj.triangle_count())
+            {
+                return (heads, true);
             }
             if !heads.iter().any(|h| h.a == e.a && h.b == e.b) {
                 heads.push(e);
             }
         }
-        if heads.is_empty() {
-            break;
-        }
-        // §5.1: sorted by target vertex, tested in parallel against the mesh as it is.
+        (heads, false)
+    }
+
+    /// §5.1: the heads sorted by target vertex, tested in parallel against the mesh as it is;
+    /// postponed ones go back to the queue at their measured distance, the accepted ones come
+    /// back in order of perceivability.
+    fn test_block(
+        &mut self,
+        mut heads: Vec<Entry>,
+        tests: &Tests,
+        perception: bool,
+    ) -> Vec<Accepted> {
         heads.sort_by_key(|e| (e.b, e.a, e.key));
         let verdicts: Vec<Verdict> = {
-            let (adj, cost, attached, tests) = (&adj, &cost, &attached, &tests);
+            let (adj, cost, attached) = (&self.adj, &self.cost, &self.attached);
             heads
                 .par_iter()
                 .map(|e| tests.verdict(adj, cost, attached, e))
                 .collect()
         };
+        let counts = &mut self.counts;
         let mut accepted = Vec::new();
         for (e, v) in heads.iter().zip(verdicts) {
             match v {
@@ -396,7 +441,7 @@ pub fn run(
                     perceptual,
                     solves,
                 } => {
-                    counts.perception_tests += u64::from(engine.perception);
+                    counts.perception_tests += u64::from(perception);
                     counts.newton_solves += solves as u64;
                     if perceptual {
                         counts.postponed_perceptual += 1;
@@ -411,15 +456,15 @@ pub fn run(
                     let key = ((distance * margin) as f32)
                         .to_bits()
                         .max((e.key + 1).min(f32::INFINITY.to_bits()));
-                    measured_before.insert(edge_key(e.a, e.b), key);
-                    heap.push(Entry { key, ..*e });
+                    self.measured_before.insert(edge_key(e.a, e.b), key);
+                    self.heap.push(Entry { key, ..*e });
                 }
                 Verdict::Accept {
                     proposal,
                     distance,
                     solves,
                 } => {
-                    counts.perception_tests += u64::from(engine.perception);
+                    counts.perception_tests += u64::from(perception);
                     counts.hausdorff_tests += 1;
                     counts.newton_solves += solves as u64;
                     accepted.push((distance, *e, proposal));
@@ -431,80 +476,127 @@ pub fn run(
             x.0.total_cmp(&y.0)
                 .then((x.1.a, x.1.b).cmp(&(y.1.a, y.1.b)))
         });
+        accepted
+    }
+
+    /// Apply a block's accepted collapses in order, each unless an earlier one changed one of
+    /// its vertices or their neighbours (it returns to the queue). `true` when the triangle goal
+    /// was reached (the loop ends).
+    fn apply(&mut self, accepted: Vec<Accepted>, stop: &Stop) -> bool {
         let mut dirty: Vec<u32> = Vec::new();
         for (distance, e, proposal) in accepted {
             let touched = |v: u32| dirty.binary_search(&v).is_ok();
             if touched(e.a)
                 || touched(e.b)
-                || adj
+                || self
+                    .adj
                     .ring(e.a)
                     .iter()
-                    .chain(adj.ring(e.b).iter())
+                    .chain(self.adj.ring(e.b).iter())
                     .any(|&v| touched(v))
             {
-                counts.invalidated += 1;
-                if let Some(n) = entry(&adj, &cost, &silhouette, &version, e.a, e.b) {
-                    heap.push(Entry {
+                self.counts.invalidated += 1;
+                let renewed = entry(
+                    &self.adj,
+                    &self.cost,
+                    &self.silhouette,
+                    &self.version,
+                    e.a,
+                    e.b,
+                );
+                if let Some(n) = renewed {
+                    self.heap.push(Entry {
                         key: n.key.max(e.key),
                         ..n
                     });
                 }
                 continue;
             }
-            if stop.distance.is_none() && stop.triangles_reached(adj.triangle_count()) {
-                break 'outer;
+            if stop.distance.is_none() && stop.triangles_reached(self.adj.triangle_count()) {
+                return true;
             }
-            let (a, b) = (proposal.a, proposal.b);
-            let Ok(map) = adj.collapse_for_good(a, b, proposal.position, &mut ring) else {
-                continue;
-            };
-            let attributes = cost.collapsed(&mut adj, a, b, &map);
-            version[a as usize] += 1;
-            version[b as usize] += 1;
-            attached.merge(a, b);
-            running = running.max(e.distance());
-            collapses.push(Collapse {
-                from: a,
-                to: b,
-                position: proposal.position,
-                error: running,
-                triangles: adj.triangle_count(),
-                attributes,
-            });
-            measured.push(distance);
-            counts.applied += 1;
-            for v in [a, b].into_iter().chain(ring.iter().copied()) {
-                if let Err(i) = dirty.binary_search(&v) {
-                    dirty.insert(i, v);
-                }
-            }
-            measured_before.remove(&edge_key(a, b));
-            for &n in &ring {
-                if let Some(mut x) = entry(&adj, &cost, &silhouette, &version, b, n) {
-                    // An edge postponed before returns no earlier than its last measurement:
-                    // a collapse next to it rarely changes it much, and testing it again at the
-                    // quadric's estimate would only postpone it again.
-                    if let Some(&k) = measured_before.get(&edge_key(b, n)) {
-                        x.key = x.key.max(k);
+            if self.collapse(distance, &e, &proposal) {
+                for v in [proposal.a, proposal.b]
+                    .into_iter()
+                    .chain(self.ring.iter().copied())
+                {
+                    if let Err(i) = dirty.binary_search(&v) {
+                        dirty.insert(i, v);
                     }
-                    heap.push(x);
                 }
             }
         }
-        if stopped {
-            break;
+        false
+    }
+
+    /// Make one accepted collapse, record it and queue the edges around its survivor; `false`
+    /// when the mesh refused it.
+    fn collapse(&mut self, distance: f64, e: &Entry, proposal: &Proposal) -> bool {
+        let (a, b) = (proposal.a, proposal.b);
+        let Ok(map) = self
+            .adj
+            .collapse_for_good(a, b, proposal.position, &mut self.ring)
+        else {
+            return false;
+        };
+        let attributes = self.cost.collapsed(&mut self.adj, a, b, &map);
+        self.version[a as usize] += 1;
+        self.version[b as usize] += 1;
+        self.attached.merge(a, b);
+        self.running = self.running.max(e.distance());
+        self.collapses.push(Collapse {
+            from: a,
+            to: b,
+            position: proposal.position,
+            error: self.running,
+            triangles: self.adj.triangle_count(),
+            attributes,
+        });
+        self.measured.push(distance);
+        self.counts.applied += 1;
+        self.measured_before.remove(&edge_key(a, b));
+        for &n in &self.ring {
+            if let Some(mut x) = entry(&self.adj, &self.cost, &self.silhouette, &self.version, b, n)
+            {
+                // An edge postponed before returns no earlier than its last measurement: a
+                // collapse next to it rarely changes it much, and testing it again at the
+                // quadric's estimate would only postpone it again.
+                if let Some(&k) = self.measured_before.get(&edge_key(b, n)) {
+                    x.key = x.key.max(k);
+                }
+                self.heap.push(x);
+            }
         }
+        true
     }
-    Outcome {
-        progressive: Progressive {
-            base,
-            collapses,
-            last: adj,
-        },
-        measured,
-        counts,
-        seconds: (setup, start.elapsed().as_secs_f64() - setup),
-    }
+}
+
+/// Every edge's queue entry at the quadric's estimate, in parallel over chunks of vertices (the
+/// order of the result is the vertices' order, whatever the thread count).
+fn initial_entries(
+    adj: &Adjacency,
+    cost: &QemCost,
+    silhouette: &Silhouette,
+    version: &[u32],
+) -> Vec<Entry> {
+    let n = adj.positions.len() as u32;
+    let chunks: Vec<Vec<Entry>> = (0..n.div_ceil(512))
+        .into_par_iter()
+        .map(|c| {
+            let mut out = Vec::new();
+            for u in c * 512..((c + 1) * 512).min(n) {
+                for v in adj.ring(u) {
+                    if v > u
+                        && let Some(e) = entry(adj, cost, silhouette, version, u, v)
+                    {
+                        out.push(e);
+                    }
+                }
+            }
+            out
+        })
+        .collect();
+    chunks.concat()
 }
 
 /// The perceptual and geometric distances (model units) of collapsing the vertex at `from` into
