@@ -62,13 +62,14 @@ impl Engine {
                     .into(),
             )),
             #[cfg(not(feature = "gpu"))]
-            Backend::Auto => Ok(Engine {
-                fallback: Some(
+            Backend::Auto => {
+                let mut e = Engine::cpu();
+                e.fallback = Some(
                     "GPU path skipped: built without the `gpu` feature; rendering on the CPU"
                         .into(),
-                ),
-                ..Engine::cpu()
-            }),
+                );
+                Ok(e)
+            }
             #[cfg(feature = "gpu")]
             Backend::Gpu => Self::open_gpu(),
             #[cfg(feature = "gpu")]

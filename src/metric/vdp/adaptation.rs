@@ -12,6 +12,14 @@
 //! moving to lower frequencies); above a few tens of cd/m² g ≈ 1 (Weber's law). At L_ref the
 //! correction is exactly 1, so ModelFest (30 cd/m², the reference) calibrates the filter alone.
 //! g_k is tabulated over ln L_a from [`L_MIN`] to [`L_MAX`] cd/m² and interpolated linearly.
+//!
+//! Daly's CSF keeps Weber's law however bright the background (it even gains at high frequencies),
+//! but observers lose sensitivity above a few thousand cd/m²: castleCSF's hdr_csf data (Gabors on
+//! 0.02 to 10 000 cd/m²) sat 5 dB above the model at 7 000–10 000 cd/m² relative to its own mean.
+//! [`HighLuminanceLoss`] multiplies sensitivity by 1/(1 + (L/L_knee)^n), normalised to 1 at the
+//! reference; its two constants are fitted on the castleCSF subset (`fitted.rs`). The form is ours:
+//! castleCSF's own peak-sensitivity term (Ashraf et al. 2024, after stelaCSF) also falls above a
+//! high-luminance knee, which is the fact taken from it.
 
 use super::bands::Plane;
 use crate::metric::csf::DalyCsf;
@@ -23,6 +31,22 @@ pub const L_MIN: f64 = 1e-3;
 pub const L_MAX: f64 = 1e5;
 const TABLE: usize = 512;
 
+/// Sensitivity lost on very bright backgrounds: a factor 1/(1 + (L/`knee_cd_m2`)^`exponent`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct HighLuminanceLoss {
+    /// The luminance, cd/m², at which sensitivity is halved.
+    pub knee_cd_m2: f64,
+    /// How steeply it falls beyond the knee (sensitivity ∝ L^−exponent far above it).
+    pub exponent: f64,
+}
+
+impl HighLuminanceLoss {
+    /// The factor at `l` cd/m².
+    pub fn factor(&self, l: f64) -> f64 {
+        1.0 / (1.0 + (l / self.knee_cd_m2).powf(self.exponent))
+    }
+}
+
 /// g_k over ln L_a for one band.
 #[derive(Debug, Clone)]
 pub(crate) struct BandAdaptation {
@@ -30,14 +54,21 @@ pub(crate) struct BandAdaptation {
 }
 
 impl BandAdaptation {
-    /// The correction for a band centred on `rho` cycles per degree, from `l_ref` cd/m².
-    pub(crate) fn new(csf: &DalyCsf, rho: f64, l_ref: f64) -> BandAdaptation {
-        let at_ref = csf.sensitivity(rho, 1.0, l_ref);
+    /// The correction for a band centred on `rho` cycles per degree, from `l_ref` cd/m², with
+    /// `loss` (if any) on bright backgrounds.
+    pub(crate) fn new(
+        csf: &DalyCsf,
+        rho: f64,
+        l_ref: f64,
+        loss: Option<HighLuminanceLoss>,
+    ) -> BandAdaptation {
+        let loss_at = |l: f64| loss.map_or(1.0, |h| h.factor(l));
+        let at_ref = csf.sensitivity(rho, 1.0, l_ref) * loss_at(l_ref);
         let table = (0..TABLE)
             .map(|i| {
                 let l = (L_MIN.ln() + (L_MAX / L_MIN).ln() * i as f64 / (TABLE - 1) as f64).exp();
                 if at_ref > 0.0 {
-                    (csf.sensitivity(rho, 1.0, l) / at_ref) as f32
+                    (csf.sensitivity(rho, 1.0, l) * loss_at(l) / at_ref) as f32
                 } else {
                     1.0
                 }
@@ -86,7 +117,7 @@ mod tests {
     fn correction_is_one_at_the_reference_and_below_one_in_the_dark() {
         let csf = DalyCsf::published();
         for rho in [0.5, 4.0, 24.0] {
-            let a = BandAdaptation::new(&csf, rho, 30.0);
+            let a = BandAdaptation::new(&csf, rho, 30.0, None);
             assert!((a.gain(30.0) - 1.0).abs() < 2e-3, "{rho}: {}", a.gain(30.0));
             assert!(a.gain(0.5) < a.gain(5.0) && a.gain(5.0) < a.gain(30.0));
             // Near Weber's law above the reference at low and middle frequencies: from 30 to
@@ -99,8 +130,8 @@ mod tests {
         }
         // The dark costs high frequencies more than low ones.
         let (lo, hi) = (
-            BandAdaptation::new(&csf, 1.0, 30.0),
-            BandAdaptation::new(&csf, 24.0, 30.0),
+            BandAdaptation::new(&csf, 1.0, 30.0, None),
+            BandAdaptation::new(&csf, 24.0, 30.0, None),
         );
         assert!(hi.gain(0.5) < lo.gain(0.5));
     }

@@ -59,6 +59,7 @@ use std::sync::{Arc, Mutex};
 
 use rayon::prelude::*;
 
+pub use adaptation::HighLuminanceLoss;
 pub use display::Display;
 pub use masking::threshold_elevation;
 pub use pooling::MAP_WINDOW_DEG;
@@ -83,6 +84,9 @@ pub struct VdpParams {
     pub csf: DalyCsf,
     /// Minkowski exponent and psychometric slope. Default value: [`fitted::BETA`].
     pub beta: f64,
+    /// Sensitivity lost on very bright backgrounds (`None`: Daly's CSF alone). Default value:
+    /// [`fitted::HIGH_LUMINANCE_KNEE`] and [`fitted::HIGH_LUMINANCE_EXPONENT`].
+    pub high_luminance: Option<HighLuminanceLoss>,
 }
 
 impl VdpParams {
@@ -96,12 +100,29 @@ impl VdpParams {
             )
             .expect("the fitted constants are positive"),
             beta: fitted::BETA,
+            high_luminance: Some(HighLuminanceLoss {
+                knee_cd_m2: fitted::HIGH_LUMINANCE_KNEE,
+                exponent: fitted::HIGH_LUMINANCE_EXPONENT,
+            }),
         }
     }
 
-    /// Parameters from a CSF and an exponent; `None` unless `beta` is finite and ≥ 1.
+    /// Parameters from a CSF and an exponent, with the fitted high-luminance loss; `None` unless
+    /// `beta` is finite and ≥ 1.
     pub fn new(csf: DalyCsf, beta: f64) -> Option<VdpParams> {
-        (beta.is_finite() && beta >= 1.0).then_some(VdpParams { csf, beta })
+        (beta.is_finite() && beta >= 1.0).then_some(VdpParams {
+            csf,
+            beta,
+            ..VdpParams::fitted()
+        })
+    }
+
+    /// These parameters with `loss` on bright backgrounds instead (`None`: none).
+    pub fn with_high_luminance(self, loss: Option<HighLuminanceLoss>) -> VdpParams {
+        VdpParams {
+            high_luminance: loss,
+            ..self
+        }
     }
 }
 
@@ -207,6 +228,7 @@ impl Vdp {
                     &params.csf,
                     band_frequency(ppd, k),
                     fitted::REFERENCE_LUMINANCE,
+                    params.high_luminance,
                 )
             })
             .collect();
