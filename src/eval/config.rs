@@ -184,9 +184,7 @@ impl RenderConfig {
                 problem,
                 fix,
             } => {
-                let line = text
-                    .find("environment =")
-                    .map_or(0, |i| text[..i].matches('\n').count() + 1);
+                let line = find_key(&key_lines(text), "render.environment").unwrap_or(0);
                 Error::Input {
                     path: file,
                     location,
@@ -785,7 +783,7 @@ impl Config {
 
     /// Cross-field checks that serde cannot express.
     fn check(&self, text: &str, path: &Path) -> Result<()> {
-        let at = At { text, path };
+        let at = At::new(text, path);
         let fail = |needle: &str, problem: String, fix: &str| at.fail(needle, problem, fix);
         if self.assets.is_empty() {
             return Err(Error::input(
@@ -828,7 +826,7 @@ impl Config {
             && !(t.is_finite() && t >= 0.0)
         {
             return Err(fail(
-                "tolerance",
+                "gate.tolerance",
                 format!("gate.tolerance {t} must be a finite number ≥ 0"),
                 "use e.g. 0.1 for 10 %",
             ));
@@ -847,14 +845,18 @@ impl Config {
             v.reflectivity.0 as f32,
         ) {
             return Err(fail(
-                "black_cd_m2",
+                "viewing.black_cd_m2",
                 format!("[viewing] {e}"),
                 "set black_cd_m2 below peak_cd_m2 (an office monitor: 0.5 and 100)",
             ));
         }
         if let Err(problem) = v.viewing().check() {
             return Err(fail(
-                if v.ppd.is_some() { "ppd" } else { "[viewing]" },
+                if v.ppd.is_some() {
+                    "viewing.ppd"
+                } else {
+                    "[viewing]"
+                },
                 format!("[viewing] {problem}"),
                 "describe a real display and viewer, or set ppd (the default display gives 67)",
             ));
@@ -872,18 +874,19 @@ impl Config {
                 &crate::limits::SURFACE_SAMPLES,
             ),
             (
-                "sheet_views",
+                "images.sheet_views",
                 self.images.sheet_views,
                 &crate::limits::SHEET_VIEWS,
             ),
             (
-                "views",
+                "distance.views",
                 self.distance.views.unwrap_or(1),
                 &crate::limits::VIEWS,
             ),
         ];
         for (key, value, bound) in counts {
-            if let Err(problem) = bound.check(key, value as u64) {
+            let name = key.rsplit('.').next().unwrap_or(key);
+            if let Err(problem) = bound.check(name, value as u64) {
                 return Err(fail(
                     key,
                     problem,
@@ -910,7 +913,7 @@ impl Config {
             );
             if let Err(problem) = crate::limits::check_memory(&job, bytes) {
                 return Err(fail(
-                    "size",
+                    "render.size",
                     problem,
                     "lower [render] size or the rig's views",
                 ));
@@ -921,7 +924,7 @@ impl Config {
             let side = self.render.size.0 as u64;
             crate::raster::check_sheet(3 * views, 3, (side, side), 4).map_err(|e| {
                 fail(
-                    "sheet_views",
+                    "images.sheet_views",
                     format!("[images] {e}"),
                     "lower sheet_views or [render] size, or set contact_sheets = false",
                 )
@@ -1138,19 +1141,93 @@ fn check_generate(a: &AssetConfig, g: &GenerateConfig, at: &At<'_>) -> Result<()
     Ok(())
 }
 
-/// Where a problem of the config text sits: errors at the line where a key first appears.
-struct At<'a> {
-    text: &'a str,
-    path: &'a Path,
+/// One key of a TOML document: its dotted path (entries of an array of tables numbered:
+/// `asset.0.name`), the line it is written on, and its value if that is a string.
+struct KeyLine {
+    path: String,
+    line: usize,
+    string: Option<String>,
 }
 
-impl At<'_> {
-    fn fail(&self, needle: &str, problem: String, fix: &str) -> Error {
-        match self.text.find(needle) {
-            Some(i) => {
-                let line = Location::Line(self.text[..i].matches('\n').count() + 1);
-                Error::input_at(self.path, line, problem, fix)
+/// Every key of a TOML document, in the order they appear. Found with the TOML parser's spans,
+/// so a key is never matched inside a comment, a string or a longer key's name.
+fn key_lines(text: &str) -> Vec<KeyLine> {
+    use toml::de::{DeTable, DeValue};
+    fn walk(text: &str, prefix: &str, table: &DeTable, out: &mut Vec<KeyLine>) {
+        for (key, value) in table {
+            let path = if prefix.is_empty() {
+                key.get_ref().to_string()
+            } else {
+                format!("{prefix}.{}", key.get_ref())
+            };
+            let start = key.span().start.min(text.len());
+            let string = match value.get_ref() {
+                DeValue::String(v) => Some(v.to_string()),
+                _ => None,
+            };
+            out.push(KeyLine {
+                path: path.clone(),
+                line: text[..start].matches('\n').count() + 1,
+                string,
+            });
+            match value.get_ref() {
+                DeValue::Table(t) => walk(text, &path, t, out),
+                DeValue::Array(items) => {
+                    for (i, item) in items.iter().enumerate() {
+                        if let DeValue::Table(t) = item.get_ref() {
+                            walk(text, &format!("{path}.{i}"), t, out);
+                        }
+                    }
+                }
+                _ => {}
             }
+        }
+    }
+    let mut out = Vec::new();
+    if let Ok(root) = DeTable::parse(text) {
+        walk(text, "", root.get_ref(), &mut out);
+    }
+    out.sort_by_key(|k| k.line);
+    out
+}
+
+/// The line of `what` in a document's keys: `"NAME"` (in quotes) is the first key whose string
+/// value is NAME; `[table]` or a key is the key whose dotted path is exactly that, else the first
+/// whose path ends with `.key` (`size` finds `render.size`; `images.size` only that one).
+fn find_key(keys: &[KeyLine], what: &str) -> Option<usize> {
+    if let Some(value) = what.strip_prefix('"').and_then(|w| w.strip_suffix('"')) {
+        return keys
+            .iter()
+            .find(|k| k.string.as_deref() == Some(value))
+            .map(|k| k.line);
+    }
+    let key = what.trim_start_matches('[').trim_end_matches(']');
+    let suffix = format!(".{key}");
+    keys.iter()
+        .find(|k| k.path == key)
+        .or_else(|| keys.iter().find(|k| k.path.ends_with(&suffix)))
+        .map(|k| k.line)
+}
+
+/// Where a problem of the config text sits: errors at the line of the key they are about.
+struct At<'a> {
+    path: &'a Path,
+    keys: Vec<KeyLine>,
+}
+
+impl<'a> At<'a> {
+    fn new(text: &str, path: &'a Path) -> At<'a> {
+        At {
+            path,
+            keys: key_lines(text),
+        }
+    }
+
+    /// An input error at the line of `what` (see [`find_key`]), or naming no line if the text
+    /// does not have it.
+    fn fail(&self, what: &str, problem: String, fix: &str) -> Error {
+        match find_key(&self.keys, what) {
+            Some(line) => Error::input_at(self.path, Location::Line(line), problem, fix),
             None => Error::input(self.path, problem, fix),
         }
     }

@@ -319,6 +319,26 @@ fn baseline_regressions_and_switch_distances_fail_the_gate() {
 }
 
 #[test]
+fn a_bad_key_is_named_at_its_own_line_not_where_its_name_first_appears() {
+    // The line came from a substring search for the key's name, so `views` was found in a
+    // comment, or inside `sheet_views`, and the message named the wrong line. The TOML parser's
+    // spans give the key's own line; an asset's problem is at the line of its name.
+    let dir = tempfile::tempdir().unwrap();
+    let mesh = model("bunny/bunny_odedstein_3k.obj");
+    let head = "# views (distance) and sheet_views (images) for asset \"b\"\nout = \"out\"\nmetrics = [\"flip\"]\n[render]\nsize = 64\nrig = \"icosahedron\"\n[images]\nsheet_views = 4\n[distance]\n";
+    for (distance, assets, want) in [
+        ("views = 0\n", asset("b", &mesh, CHAIN), "line 10"),
+        ("views = 1\n", asset("b", &mesh, ""), "line 12"),
+    ] {
+        let path = dir.path().join("c.toml");
+        std::fs::write(&path, format!("{head}{distance}{assets}")).unwrap();
+        let r = lodeval(["eval", path.to_str().unwrap()]);
+        assert_eq!(r.code, 2, "{}", r.stderr);
+        assert!(r.stderr.contains(want), "want {want}: {}", r.stderr);
+    }
+}
+
+#[test]
 fn bad_configs_exit_2_naming_the_file_key_and_line() {
     let dir = tempfile::tempdir().unwrap();
     let src = model("bunny/bunny_odedstein_3k.obj");
