@@ -3,48 +3,53 @@
 use std::path::{Path, PathBuf};
 
 use crate::error::{Error, Result};
+use crate::metric::Metric;
 
-/// The metrics `lodeval diff` computes.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
-#[serde(rename_all = "lowercase")]
-pub enum DiffMetric {
-    /// ꟻLIP mean error in [0, 1].
-    Flip,
-    /// SSIM (sRGB luma) in [−1, 1].
-    Ssim,
-    /// MS-SSIM (sRGB luma) in [0, 1].
-    Msssim,
-    /// PSNR of the 8-bit sRGB encodings over all three channels (as scikit-image, ffmpeg and
-    /// idiff report it), dB.
-    Psnr,
-    /// PSNR of linear Rec. 709 luminance (peak 1), dB.
-    #[serde(rename = "psnr_luminance")]
-    PsnrLuminance,
-    /// MSE of linear luminance.
-    Mse,
-    /// Visible-difference predictor: value = detection probability in [0, 1]; `jnd` also given.
-    Vdp,
+/// What `diff --metric` asks for: one metric of [`Metric::DIFF`], or `all` of them. Its command
+/// line names and help come from `metric::catalog`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct MetricChoice(pub Option<Metric>);
+
+impl MetricChoice {
+    /// The metrics it asks for, in output order.
+    pub fn metrics(self) -> Vec<Metric> {
+        match self.0 {
+            Some(m) => vec![m],
+            None => Metric::DIFF.to_vec(),
+        }
+    }
 }
 
-impl DiffMetric {
-    /// Every metric `diff` can compute, in output order.
-    pub const ALL: [DiffMetric; 7] = [
-        DiffMetric::Flip,
-        DiffMetric::Ssim,
-        DiffMetric::Msssim,
-        DiffMetric::Psnr,
-        DiffMetric::PsnrLuminance,
-        DiffMetric::Mse,
-        DiffMetric::Vdp,
-    ];
+impl clap::ValueEnum for MetricChoice {
+    fn value_variants<'a>() -> &'a [Self] {
+        const CHOICES: [MetricChoice; 8] = {
+            let mut c = [MetricChoice(None); 8];
+            let mut i = 0;
+            while i < Metric::DIFF.len() {
+                c[i] = MetricChoice(Some(Metric::DIFF[i]));
+                i += 1;
+            }
+            c
+        };
+        &CHOICES
+    }
+
+    fn to_possible_value(&self) -> Option<clap::builder::PossibleValue> {
+        use clap::builder::PossibleValue;
+        Some(match self.0 {
+            Some(m) => PossibleValue::new(m.name().replace('_', "-")).help(m.entry().what),
+            None => PossibleValue::new("all")
+                .help("Every metric (those that do not apply to the image size say why)"),
+        })
+    }
 }
 
 /// One metric's result for `lodeval diff`.
 #[derive(Debug, Clone, serde::Serialize)]
 pub struct DiffResult {
     /// Metric name.
-    pub metric: DiffMetric,
-    /// The pooled value (see [`DiffMetric`] for units); `null` in JSON for an infinite PSNR.
+    pub metric: Metric,
+    /// The pooled value (units in `metric::catalog`); `null` in JSON for an infinite PSNR.
     pub value: Option<f64>,
     /// Pixels per degree used.
     pub ppd: f64,
@@ -94,75 +99,11 @@ pub struct WorstPixel {
     pub value: f64,
 }
 
-impl DiffMetric {
-    /// The name on the command line and in outputs.
-    pub fn name(self) -> &'static str {
-        match self {
-            DiffMetric::Flip => "flip",
-            DiffMetric::Ssim => "ssim",
-            DiffMetric::Msssim => "msssim",
-            DiffMetric::Psnr => "psnr",
-            DiffMetric::PsnrLuminance => "psnr_luminance",
-            DiffMetric::Mse => "mse",
-            DiffMetric::Vdp => "vdp",
-        }
-    }
-
-    /// Whether a larger value means a larger difference (FLIP, MSE, the VDP) rather than a
-    /// smaller one (SSIM, MS-SSIM, PSNR).
-    pub fn larger_is_worse(self) -> bool {
-        crate::eval::tables::higher_is_worse(self.name())
-    }
-
-    /// The values the metric can take: FLIP's mean error and the VDP's probability lie in
-    /// [0, 1], SSIM and MS-SSIM in [−1, 1], MSE is at least 0, PSNR of 8-bit encodings at least
-    /// 0 dB; PSNR of (possibly HDR) luminance is unbounded.
-    pub fn range(self) -> (f64, f64) {
-        match self {
-            DiffMetric::Flip | DiffMetric::Vdp => (0.0, 1.0),
-            DiffMetric::Ssim | DiffMetric::Msssim => (-1.0, 1.0),
-            DiffMetric::Mse | DiffMetric::Psnr => (0.0, f64::INFINITY),
-            DiffMetric::PsnrLuminance => (f64::NEG_INFINITY, f64::INFINITY),
-        }
-    }
-
-    /// `Err` with the reason when `limit` (a `--fail`/`--warn` value named `flag`) makes a gate
-    /// that can never fail, or always does, since no value of the metric lies beyond it.
-    pub fn check_limit(self, flag: &str, limit: f64) -> std::result::Result<(), String> {
-        let (lo, hi) = self.range();
-        let name = self.name();
-        let never = if self.larger_is_worse() {
-            limit >= hi
-        } else {
-            limit <= lo
-        };
-        let always = if self.larger_is_worse() {
-            limit < lo
-        } else {
-            limit > hi
-        };
-        let span = format!("{name} lies in [{lo}, {hi}]");
-        if never {
-            return Err(format!(
-                "{flag} {limit}: {span}, so no result is ever worse than {limit} and the gate \
-                 could never fail; give a limit inside the range"
-            ));
-        }
-        if always {
-            return Err(format!(
-                "{flag} {limit}: {span}, so every result is worse than {limit} and the gate \
-                 would always fail; give a limit inside the range"
-            ));
-        }
-        Ok(())
-    }
-}
-
 impl DiffGates {
     /// `Err` with the reason when a gate can never fail or always fails for `metric`: a limit
     /// outside the metric's range, a percentage outside [0, 100), a pixel threshold outside
     /// [0, 1) of the map's values.
-    pub fn check(&self, metric: DiffMetric) -> std::result::Result<(), String> {
+    pub fn check(&self, metric: Metric) -> std::result::Result<(), String> {
         for (flag, v) in [("--fail", self.fail), ("--warn", self.warn)] {
             if let Some(v) = v {
                 metric.check_limit(flag, v)?;
@@ -207,7 +148,7 @@ pub struct DiffGates {
 /// What the gates say of one result: `None` when it passes, else the reason.
 pub fn judge(r: &DiffResult, gates: &DiffGates) -> (Option<String>, Option<String>) {
     let worse = |v: f64, limit: f64| {
-        if r.metric.larger_is_worse() {
+        if r.metric.higher_is_worse() {
             v > limit
         } else {
             v < limit
@@ -220,7 +161,7 @@ pub fn judge(r: &DiffResult, gates: &DiffGates) -> (Option<String>, Option<Strin
             format!(
                 "{name} {} is {} the {verb} limit {}",
                 crate::limits::Quantity::show(v),
-                if r.metric.larger_is_worse() {
+                if r.metric.higher_is_worse() {
                     "above"
                 } else {
                     "below"
@@ -274,13 +215,6 @@ pub fn is_exr(path: &Path) -> bool {
         .is_some_and(|e| e.eq_ignore_ascii_case("exr"))
 }
 
-impl DiffMetric {
-    /// Whether the metric has a per-pixel map (a heat map, `--fail-percent`).
-    pub fn has_map(self) -> bool {
-        matches!(self, DiffMetric::Flip | DiffMetric::Ssim | DiffMetric::Vdp)
-    }
-}
-
 /// What every metric of one comparison shares.
 struct Pair<'a> {
     engine: &'a crate::backend::Engine,
@@ -331,7 +265,7 @@ pub fn diff(
     engine: &crate::backend::Engine,
     reference: &Path,
     test: &Path,
-    metrics: &[DiffMetric],
+    metrics: &[Metric],
     seen: &Seen,
     options: &DiffOptions<'_>,
 ) -> Result<Vec<DiffResult>> {
@@ -346,7 +280,7 @@ pub fn diff(
         b,
     };
     let with_maps = metrics.iter().filter(|m| m.has_map()).count();
-    let map_path = |metric: DiffMetric| -> Option<PathBuf> {
+    let map_path = |metric: Metric| -> Option<PathBuf> {
         let p = options.map.filter(|_| metric.has_map())?;
         if with_maps <= 1 {
             return Some(p.to_path_buf());
@@ -372,7 +306,7 @@ pub fn diff(
             note: None,
             jnd: None,
             backend: match metric {
-                DiffMetric::Flip | DiffMetric::Mse | DiffMetric::PsnrLuminance => engine.describe(),
+                Metric::Flip | Metric::Mse | Metric::PsnrLuminance => engine.describe(),
                 _ => crate::backend::CPU_RENDERER.to_string(),
             },
             worst_pixel: None,
@@ -410,7 +344,7 @@ fn score(pair: &Pair<'_>, r: &mut DiffResult) -> Result<Option<Vec<f32>>> {
     use crate::metric::{flip::Flip, pool, ssim};
     let (a, b) = (&pair.a, &pair.b);
     match r.metric {
-        DiffMetric::Flip => {
+        Metric::Flip => {
             let s = if pair.hdr {
                 let flip = Flip::new(pair.ppd as f32);
                 let h = crate::metric::hdr_flip::hdr_flip(&flip, a, b, pair.exposures)?;
@@ -426,7 +360,7 @@ fn score(pair: &Pair<'_>, r: &mut DiffResult) -> Result<Option<Vec<f32>>> {
             let v = s.map.values;
             let mut p = std::collections::BTreeMap::new();
             for q in [25.0, 50.0, 75.0, 95.0, 99.0] {
-                p.insert(format!("p{q}"), pool::percentile(&v, q));
+                p.insert(format!("p{q}"), pool::percentile(&v, q).unwrap_or(0.0));
             }
             // FLIP's weighted percentiles (what NVIDIA's tool reports).
             p.insert("weighted_p25".into(), pool::weighted_percentile(&v, 0.25));
@@ -438,34 +372,39 @@ fn score(pair: &Pair<'_>, r: &mut DiffResult) -> Result<Option<Vec<f32>>> {
             r.histogram = Some(pool::histogram(&v, 20));
             Ok(Some(v))
         }
-        DiffMetric::Ssim => {
+        Metric::Ssim => {
             let (mean, smap) = ssim::ssim(a, b, ssim::SsimInput::SrgbLuma)?;
             r.value = Some(mean);
             Ok(Some(
                 smap.iter().map(|s| (1.0 - s).clamp(0.0, 1.0)).collect(),
             ))
         }
-        DiffMetric::Msssim => {
+        Metric::Msssim => {
             r.value = Some(ssim::ms_ssim(a, b, ssim::SsimInput::SrgbLuma)?);
             Ok(None)
         }
-        DiffMetric::Psnr => {
+        Metric::Psnr => {
             r.value = Some(crate::metric::mse::psnr_srgb8(a, b)?);
             Ok(None)
         }
-        DiffMetric::PsnrLuminance => {
+        Metric::PsnrLuminance => {
             r.value = Some(pair.engine.mse(a, b)?.psnr_db);
             Ok(None)
         }
-        DiffMetric::Mse => {
+        Metric::Mse => {
             r.value = Some(pair.engine.mse(a, b)?.mse);
             Ok(None)
         }
-        DiffMetric::Vdp => {
+        Metric::Vdp => {
             let s = pair.vdp.compare(a, b)?;
             r.value = Some(s.probability);
             r.jnd = Some(s.jnd);
             Ok(Some(s.map.values))
+        }
+        other @ (Metric::FlipP95 | Metric::FlipShare | Metric::VdpJnd) => {
+            Err(Error::Usage(format!(
+                "diff does not compute {other}: it reports FLIP's percentiles and the VDP's JND with flip and vdp"
+            )))
         }
     }
 }

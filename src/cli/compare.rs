@@ -6,6 +6,7 @@ use std::path::PathBuf;
 use clap::Args;
 use lodeval::Error;
 use lodeval::eval::compare::{CompareJob, CompareReport};
+use lodeval::metric::Metric;
 
 use super::args::{BackendArg, LookArgs, count, parse_shading};
 use super::print::{emit, emit_json, warnings};
@@ -65,11 +66,19 @@ pub(crate) fn run(a: CompareArgs, quiet: bool) -> Result<(), Error> {
 
 /// The per-view table, the summary and the distances as text.
 fn table(r: &CompareReport) -> String {
-    let metrics: Vec<&str> = r
+    // The console's columns; every metric is in --json and the CSVs.
+    const COLUMNS: [Metric; 5] = [
+        Metric::Flip,
+        Metric::Ssim,
+        Metric::Psnr,
+        Metric::Vdp,
+        Metric::VdpJnd,
+    ];
+    let metrics: Vec<Metric> = r
         .summary
         .iter()
-        .map(|s| s.metric.as_str())
-        .filter(|m| ["flip", "ssim", "psnr", "vdp", "vdp_jnd"].contains(m))
+        .map(|s| s.metric)
+        .filter(|m| COLUMNS.contains(m))
         .collect();
     let mut s = format!(
         "{} triangles against {} ({:.4} of the original)\n\n{:>5}",
@@ -79,7 +88,7 @@ fn table(r: &CompareReport) -> String {
         "view"
     );
     for m in &metrics {
-        s.push_str(&format!(" {m:>9}"));
+        s.push_str(&format!(" {:>9}", m.name()));
     }
     s.push('\n');
     let mut views: Vec<usize> = r.views.iter().map(|v| v.view).collect();
@@ -107,7 +116,7 @@ fn table(r: &CompareReport) -> String {
             // The worst view in the metric's own direction (lowest SSIM, MS-SSIM and PSNR).
             let x = if label == "mean" {
                 r.summary.iter().find(|x| x.metric == *m).map(|x| x.mean)
-            } else if lodeval::eval::tables::higher_is_worse(m) {
+            } else if m.higher_is_worse() {
                 values.reduce(f64::max)
             } else {
                 values.reduce(f64::min)

@@ -2,50 +2,13 @@
 
 use std::path::PathBuf;
 
-use clap::{Args, ValueEnum};
+use clap::Args;
 use lodeval::Error;
-use lodeval::app::DiffMetric;
+use lodeval::app::MetricChoice;
+use lodeval::metric::Metric;
 
 use super::args::{BackendArg, value};
 use super::print::{emit, emit_json, warnings};
-
-/// `--metric`.
-#[derive(Copy, Clone, Debug, PartialEq, Eq, ValueEnum)]
-pub(crate) enum MetricArg {
-    /// ꟻLIP mean error.
-    Flip,
-    /// SSIM on sRGB luma.
-    Ssim,
-    /// Multi-scale SSIM (images of at least 176×176).
-    Msssim,
-    /// PSNR of the 8-bit sRGB encodings, all three channels (as scikit-image, ffmpeg, idiff).
-    Psnr,
-    /// PSNR of linear luminance (peak 1).
-    #[value(name = "psnr-luminance")]
-    PsnrLuminance,
-    /// MSE of linear luminance.
-    Mse,
-    /// The visible-difference predictor (probability and JND).
-    Vdp,
-    /// Every metric (those that do not apply to the image size say why).
-    All,
-}
-
-impl MetricArg {
-    /// The metrics it asks for.
-    fn metrics(self) -> Vec<DiffMetric> {
-        match self {
-            MetricArg::Flip => vec![DiffMetric::Flip],
-            MetricArg::Ssim => vec![DiffMetric::Ssim],
-            MetricArg::Msssim => vec![DiffMetric::Msssim],
-            MetricArg::Psnr => vec![DiffMetric::Psnr],
-            MetricArg::PsnrLuminance => vec![DiffMetric::PsnrLuminance],
-            MetricArg::Mse => vec![DiffMetric::Mse],
-            MetricArg::Vdp => vec![DiffMetric::Vdp],
-            MetricArg::All => DiffMetric::ALL.to_vec(),
-        }
-    }
-}
 
 #[derive(Args, Debug)]
 #[command(
@@ -61,8 +24,8 @@ pub(crate) struct DiffArgs {
     #[arg(required = true, num_args = 1..)]
     pub(crate) test: Vec<PathBuf>,
     /// Metric: flip, ssim, msssim, psnr, mse, vdp or all.
-    #[arg(long, value_enum, default_value_t = MetricArg::Flip)]
-    pub(crate) metric: MetricArg,
+    #[arg(long, value_enum, default_value_t = MetricChoice(Some(Metric::Flip)))]
+    pub(crate) metric: MetricChoice,
     /// Pixels per degree of visual angle (overrides the display flags).
     #[arg(long, conflicts_with_all = ["display_width_m", "display_px", "distance_m"],
           value_parser = value(&lodeval::limits::PPD))]
@@ -168,7 +131,7 @@ pub(crate) fn run(a: DiffArgs) -> Result<(), Error> {
     };
     viewing.check().map_err(Error::Usage)?;
     // With `all`, metrics that do not apply to this image size report a note instead.
-    let lenient = a.metric == MetricArg::All;
+    let lenient = a.metric.0.is_none();
     let engine = lodeval::backend::Engine::new(a.backend.into())?;
     warnings(
         &engine
@@ -201,7 +164,7 @@ pub(crate) fn run(a: DiffArgs) -> Result<(), Error> {
     gates.check(gated).map_err(Error::Usage)?;
     let is_exr = lodeval::app::is_exr;
     let all_exr = is_exr(&a.reference) && a.test.iter().all(|t| is_exr(t));
-    if a.start_exposure.is_some() && !(all_exr && metrics.contains(&DiffMetric::Flip)) {
+    if a.start_exposure.is_some() && !(all_exr && metrics.contains(&Metric::Flip)) {
         warnings(&["--start-exposure, --stop-exposure and --num-exposures apply to HDR-FLIP                     (--metric flip on two EXR images) only; they do nothing here"
             .to_string()]);
     }

@@ -16,6 +16,7 @@ use std::path::{Path, PathBuf};
 use serde::Deserialize;
 
 use crate::error::{Error, Location, Result};
+use crate::metric::Metric;
 use crate::metric::vdp::Display;
 use crate::raster::{RenderSettings, SamplePattern, Shading, ToneMapping};
 use crate::scene::{Light, Lighting, Rig, Viewing};
@@ -484,18 +485,87 @@ pub struct Thresholds {
 }
 
 impl Thresholds {
-    /// Every threshold as (name, value), in a fixed order.
+    /// Every threshold as (key, value), in [`THRESHOLD_KEYS`] order.
     pub fn entries(&self) -> [(&'static str, Option<f64>); 8] {
-        [
-            ("flip_mean", self.flip_mean),
-            ("flip_worst_view", self.flip_worst_view),
-            ("flip_p95", self.flip_p95),
-            ("flip_share", self.flip_share),
-            ("vdp_probability", self.vdp_probability),
-            ("psnr_min", self.psnr_min),
-            ("ssim_min", self.ssim_min),
-            ("msssim_min", self.msssim_min),
-        ]
+        let v = [
+            self.flip_mean,
+            self.flip_worst_view,
+            self.flip_p95,
+            self.flip_share,
+            self.vdp_probability,
+            self.psnr_min,
+            self.ssim_min,
+            self.msssim_min,
+        ];
+        std::array::from_fn(|i| (THRESHOLD_KEYS[i].key, v[i]))
+    }
+}
+
+/// The statistic over views a threshold bounds.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Statistic {
+    /// The mean over views.
+    Mean,
+    /// The worst view, in the metric's direction.
+    WorstView,
+}
+
+impl Statistic {
+    /// How a chart or a message names it.
+    pub fn label(self) -> &'static str {
+        match self {
+            Statistic::Mean => "mean",
+            Statistic::WorstView => "worst view",
+        }
+    }
+}
+
+/// What a threshold key bounds: a metric of `metric::catalog`, over a statistic; from above for
+/// metrics where higher is worse, from below for the others.
+#[derive(Debug, Clone, Copy)]
+pub struct ThresholdKey {
+    /// The key in `[thresholds]`.
+    pub key: &'static str,
+    /// The metric it bounds.
+    pub metric: Metric,
+    /// The statistic over views.
+    pub statistic: Statistic,
+}
+
+/// Every threshold key, in the order of [`Thresholds`]' fields.
+pub const THRESHOLD_KEYS: [ThresholdKey; 8] = {
+    const fn k(key: &'static str, metric: Metric, statistic: Statistic) -> ThresholdKey {
+        ThresholdKey {
+            key,
+            metric,
+            statistic,
+        }
+    }
+    use Statistic::{Mean, WorstView};
+    [
+        k("flip_mean", Metric::Flip, Mean),
+        k("flip_worst_view", Metric::Flip, WorstView),
+        k("flip_p95", Metric::FlipP95, WorstView),
+        k("flip_share", Metric::FlipShare, WorstView),
+        k("vdp_probability", Metric::Vdp, WorstView),
+        k("psnr_min", Metric::Psnr, WorstView),
+        k("ssim_min", Metric::Ssim, WorstView),
+        k("msssim_min", Metric::Msssim, WorstView),
+    ]
+};
+
+impl ThresholdKey {
+    /// The entry of a key from [`Thresholds::entries`].
+    pub fn of(key: &str) -> &'static ThresholdKey {
+        THRESHOLD_KEYS
+            .iter()
+            .find(|k| k.key == key)
+            .expect("a key from Thresholds::entries")
+    }
+
+    /// Whether it bounds from above (the metric gets worse upwards).
+    pub fn upper(&self) -> bool {
+        self.metric.higher_is_worse()
     }
 }
 
@@ -605,21 +675,7 @@ pub struct GenerateConfig {
     pub switch_m: Vec<Positive>,
 }
 
-/// Metric families; each writes one or more `metric` values into `metrics.csv`.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Deserialize)]
-#[serde(rename_all = "lowercase")]
-pub enum MetricFamily {
-    /// `flip` (mean), `flip_p95`, `flip_share`.
-    Flip,
-    /// `ssim`.
-    Ssim,
-    /// `msssim` (images ≥ 176 px per side).
-    Msssim,
-    /// `psnr` and `mse` (luminance).
-    Psnr,
-    /// `vdp` (detection probability) and `vdp_jnd`.
-    Vdp,
-}
+pub use crate::metric::MetricFamily;
 
 macro_rules! checked_newtype {
     ($(#[$m:meta])* $name:ident($inner:ty), $from:literal, |$v:ident| $check:expr, $why:expr) => {
@@ -1233,17 +1289,14 @@ impl<'a> At<'a> {
     }
 }
 
-const THRESHOLD_FIX: &str =
-    "thresholds are finite numbers (FLIP, shares and probabilities between 0 and 1)";
+const THRESHOLD_FIX: &str = "thresholds are finite numbers in their metric's range (FLIP, shares \
+     and probabilities between 0 and 1, SSIM between -1 and 1, PSNR at least 0 dB)";
 
 fn check_thresholds(t: &Thresholds) -> std::result::Result<(), String> {
     for (name, v) in t.entries() {
         let Some(v) = v else { continue };
-        let unit = matches!(
-            name,
-            "flip_mean" | "flip_worst_view" | "flip_p95" | "flip_share" | "vdp_probability"
-        );
-        if !v.is_finite() || (unit && !(0.0..=1.0).contains(&v)) {
+        let (lo, hi) = ThresholdKey::of(name).metric.range();
+        if !v.is_finite() || !(lo..=hi).contains(&v) {
             return Err(format!("threshold {name} = {v} is out of range"));
         }
     }

@@ -10,10 +10,11 @@
 
 use std::path::Path;
 
-use super::config::config_dir;
+use super::config::{Statistic, ThresholdKey, config_dir};
 use super::plan::Plan;
-use super::tables::{DistanceBound, DistanceRow, Results, SummaryRow, higher_is_worse, read_csv};
+use super::tables::{DistanceBound, DistanceRow, Results, SummaryRow, read_csv};
 use crate::error::{Error, Location, Result};
+use crate::metric::Metric;
 
 /// One failed check.
 #[derive(Debug, Clone, PartialEq)]
@@ -31,7 +32,7 @@ pub struct Failure {
 /// Evaluate every check of `plan` against `results`.
 pub fn check(plan: &Plan, results: &Results) -> Result<Vec<Failure>> {
     let mut failures = Vec::new();
-    let computed = |metric: &str| results.rows.iter().any(|r| r.metric == metric);
+    let computed = |metric: Metric| results.rows.iter().any(|r| r.metric == metric);
     for asset in &plan.assets {
         for lod in &asset.lods {
             if !results
@@ -50,16 +51,8 @@ pub fn check(plan: &Plan, results: &Results) -> Result<Vec<Failure>> {
                 })
             };
             for limit in &lod.limits {
-                let (metric, worst_view, upper) = match limit.name {
-                    "flip_mean" => ("flip", false, true),
-                    "flip_worst_view" => ("flip", true, true),
-                    "flip_p95" => ("flip_p95", true, true),
-                    "flip_share" => ("flip_share", true, true),
-                    "vdp_probability" => ("vdp", true, true),
-                    "psnr_min" => ("psnr", true, false),
-                    "ssim_min" => ("ssim", true, false),
-                    _ => ("msssim", true, false),
-                };
+                let key = ThresholdKey::of(limit.name);
+                let (metric, upper) = (key.metric, key.upper());
                 if !computed(metric) {
                     return Err(Error::input(
                         &plan.config_path,
@@ -70,7 +63,7 @@ pub fn check(plan: &Plan, results: &Results) -> Result<Vec<Failure>> {
                         "add its family to `metrics` or remove the threshold",
                     ));
                 }
-                let (value, where_) = if worst_view {
+                let (value, where_) = if key.statistic == Statistic::WorstView {
                     match results.worst(&asset.name, &lod.name, metric) {
                         Some((v, x)) => (x, format!(" (view {v})")),
                         None => continue,
@@ -236,7 +229,7 @@ pub fn against_baseline(
             continue;
         };
         let slack = tolerance * b.mean.abs() + absolute;
-        let worse = if higher_is_worse(&row.metric) {
+        let worse = if row.metric.higher_is_worse() {
             row.mean > b.mean + slack
         } else {
             row.mean < b.mean - slack

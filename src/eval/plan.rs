@@ -11,7 +11,7 @@
 
 use std::path::{Path, PathBuf};
 
-use super::config::{Config, MetricFamily, Thresholds, config_dir, resolve};
+use super::config::{Config, ThresholdKey, Thresholds, config_dir, resolve};
 use crate::error::{Error, Result};
 use crate::simplify::{Goal, Method};
 
@@ -253,14 +253,16 @@ impl Plan {
         for asset in &self.assets {
             for lod in &asset.lods {
                 for limit in &lod.limits {
-                    let (family, family_name) = threshold_family(limit.name);
+                    let family = ThresholdKey::of(limit.name).metric.family();
                     if !computed.contains(&family) {
                         return Err(Error::input(
                             &self.config_path,
                             format!(
                                 "threshold {} (set in {}) needs the metric family '{}', which \
                                  the config does not compute",
-                                limit.name, limit.origin, family_name
+                                limit.name,
+                                limit.origin,
+                                family.name()
                             ),
                             "add its family to `metrics` or remove the threshold",
                         ));
@@ -296,17 +298,6 @@ impl Plan {
             .iter()
             .flat_map(|a| a.lods.iter().map(|l| case_id(&a.name, &l.name)))
             .collect()
-    }
-}
-
-/// The metric family a threshold bounds, and its name in `metrics`.
-fn threshold_family(name: &str) -> (MetricFamily, &'static str) {
-    match name {
-        "flip_mean" | "flip_worst_view" | "flip_p95" | "flip_share" => (MetricFamily::Flip, "flip"),
-        "vdp_probability" => (MetricFamily::Vdp, "vdp"),
-        "psnr_min" => (MetricFamily::Psnr, "psnr"),
-        "ssim_min" => (MetricFamily::Ssim, "ssim"),
-        _ => (MetricFamily::Msssim, "msssim"),
     }
 }
 

@@ -13,47 +13,15 @@
 
 use std::path::Path;
 
+use super::config::ThresholdKey;
 use super::plan::Plan;
 use super::tables::Results;
 use crate::error::Result;
 use crate::io::plot_png::{self, Chart, Line, Mark};
+use crate::metric::Metric;
 
-/// A plotted metric: its column, its axis title, and the gate limits that bound it (limit name,
-/// the statistic it bounds).
-type PlottedMetric = (
-    &'static str,
-    &'static str,
-    &'static [(&'static str, &'static str)],
-);
-
-/// The metrics plotted.
-const METRICS: [PlottedMetric; 5] = [
-    (
-        "flip",
-        "FLIP (0 = identical)",
-        &[("flip_mean", "mean"), ("flip_worst_view", "worst view")],
-    ),
-    (
-        "vdp",
-        "VDP detection probability",
-        &[("vdp_probability", "worst view")],
-    ),
-    (
-        "ssim",
-        "SSIM (1 = identical)",
-        &[("ssim_min", "worst view")],
-    ),
-    (
-        "psnr",
-        "PSNR (8-bit sRGB), dB (higher is closer)",
-        &[("psnr_min", "worst view")],
-    ),
-    (
-        "msssim",
-        "MS-SSIM (1 = identical)",
-        &[("msssim_min", "worst view")],
-    ),
-];
+/// The metrics plotted, in this order, each with its catalogue title.
+const PLOTTED: [Metric; 5] = Metric::LEADING;
 
 /// Write every plot of `results` into `dir/plots/`.
 pub fn write(plan: &Plan, results: &Results, dir: &Path) -> Result<()> {
@@ -70,7 +38,8 @@ pub fn write(plan: &Plan, results: &Results, dir: &Path) -> Result<()> {
             at: first.original_triangles as f64,
             label: format!("original {}", first.original_triangles),
         };
-        for (metric, title, limits) in METRICS {
+        for metric in PLOTTED {
+            let title = metric.entry().title;
             if !results
                 .rows
                 .iter()
@@ -100,10 +69,11 @@ pub fn write(plan: &Plan, results: &Results, dir: &Path) -> Result<()> {
             let mut h_marks: Vec<Mark> = Vec::new();
             for lod in &asset.lods {
                 for limit in &lod.limits {
-                    let Some((_, stat)) = limits.iter().find(|(n, _)| *n == limit.name) else {
+                    let key = ThresholdKey::of(limit.name);
+                    if key.metric != metric {
                         continue;
-                    };
-                    let label = format!("gate: {stat} limit {}", limit.value);
+                    }
+                    let label = format!("gate: {} limit {}", key.statistic.label(), limit.value);
                     if !h_marks.iter().any(|m| m.label == label) {
                         h_marks.push(Mark {
                             at: limit.value,
@@ -121,7 +91,7 @@ pub fn write(plan: &Plan, results: &Results, dir: &Path) -> Result<()> {
                 log_x: true,
                 h_marks,
                 v_marks: vec![original.clone()],
-                tight_y: metric == "psnr",
+                tight_y: metric == Metric::Psnr,
             };
             plot_png::write(
                 &dir.join("plots")

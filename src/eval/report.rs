@@ -12,6 +12,7 @@ use std::fmt::Write;
 use super::gate::Failure;
 use super::plan::Plan;
 use super::tables::{DistanceRow, Results};
+use crate::metric::Metric;
 
 fn esc(s: &str) -> String {
     s.replace('&', "&amp;")
@@ -144,7 +145,7 @@ pub fn render(plan: &Plan, results: &Results, failures: &[Failure]) -> String {
 
 /// Inline SVG: FLIP mean (or the first metric) over views against triangle count, log x axis.
 fn plot(results: &Results, asset: &str, original: usize) -> String {
-    let metric = ["flip", "vdp", "ssim", "psnr", "msssim"]
+    let metric = Metric::LEADING
         .into_iter()
         .find(|m| {
             results
@@ -152,7 +153,7 @@ fn plot(results: &Results, asset: &str, original: usize) -> String {
                 .iter()
                 .any(|r| r.asset == asset && r.metric == *m)
         })
-        .unwrap_or("flip");
+        .unwrap_or(Metric::Flip);
     let mut pts: Vec<(f64, f64)> = results
         .lods
         .iter()

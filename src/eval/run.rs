@@ -26,11 +26,11 @@ use super::config::{GltfExport, HeatmapChoice, MetricFamily};
 use super::distance::{self, DistanceJob};
 use super::plan::{AssetPlan, LodSource, Plan, Shard, case_id};
 use super::score::Scorer;
-use super::tables::{LodInfo, MetricRow, Results, higher_is_worse, round7};
+use super::tables::{LodInfo, MetricRow, Results, round7};
 use crate::backend::SceneRenderer;
 use crate::error::Result;
 use crate::mesh::{self, LoadOptions, Mesh, surface_distance};
-use crate::metric::{LinearImage, colormap};
+use crate::metric::{LinearImage, Metric, colormap};
 use crate::progress::Progress;
 use crate::raster::{self, RenderScene};
 
@@ -75,7 +75,7 @@ struct LodScene {
 type Tiles = [image::RgbImage; 3];
 
 /// One LOD scored from one view: (metric, value) pairs and its sheet tiles.
-type LodOfView = (Vec<(&'static str, f64)>, Option<Tiles>);
+type LodOfView = (Vec<(Metric, f64)>, Option<Tiles>);
 
 /// Thumbnails kept for one LOD's contact sheet: per view (original, LOD, heat map).
 type SheetViews = Vec<(usize, Tiles)>;
@@ -298,7 +298,7 @@ fn worst_heat_maps(
                 let b = LinearImage::from(&lod_renderer.render(camera, settings)?);
                 let scored = scorer.score(&reference, &b)?;
                 for (metric, map) in &scored.maps {
-                    write_heat_map(out_dir, asset, &lod.name, view, metric, map)?;
+                    write_heat_map(out_dir, asset, &lod.name, view, *metric, map)?;
                 }
                 Ok(())
             })
@@ -453,7 +453,7 @@ fn score_views(
                     lod: lod.name.clone(),
                     triangles: lod.info.triangles,
                     view: v,
-                    metric: metric.to_string(),
+                    metric,
                     value,
                     renderer: renderer.to_string(),
                 });
@@ -521,7 +521,7 @@ fn score_lod(
         && cfg.images.heatmaps == HeatmapChoice::All
     {
         for (metric, map) in &scored.maps {
-            write_heat_map(out_dir, at.asset, &lod.name, v, metric, map)?;
+            write_heat_map(out_dir, at.asset, &lod.name, v, *metric, map)?;
         }
     }
     let thumbs = scored.maps.first().map(|(metric, map)| {
@@ -540,7 +540,7 @@ fn score_lod(
             captioned(thumbnail(&test_rgb8), &format!("view {v} · {}", lod.name)),
             captioned(
                 thumbnail(&heat),
-                &format!("{}{score}", metric.to_uppercase()),
+                &format!("{}{score}", metric.name().to_uppercase()),
             ),
         ]
     });
@@ -599,30 +599,23 @@ pub fn worst_first(
     lod: &str,
     families: &[MetricFamily],
 ) -> Vec<usize> {
-    let metric = if families.contains(&MetricFamily::Flip) {
-        "flip"
-    } else if families.contains(&MetricFamily::Vdp) {
-        "vdp"
-    } else if families.contains(&MetricFamily::Ssim) {
-        "ssim"
-    } else if families.contains(&MetricFamily::Psnr) {
-        "psnr"
-    } else {
-        "msssim"
-    };
+    let metric = Metric::LEADING
+        .into_iter()
+        .find(|m| families.contains(&m.family()))
+        .unwrap_or(Metric::Msssim);
     let mut views: Vec<(usize, f64)> = results
         .rows
         .iter()
         .filter(|r| r.asset == asset && r.lod == lod && r.metric == metric)
         .map(|r| (r.view, r.value))
         .collect();
-    let sign = if higher_is_worse(metric) { -1.0 } else { 1.0 };
+    let sign = if metric.higher_is_worse() { -1.0 } else { 1.0 };
     views.sort_by(|a, b| (sign * a.1).total_cmp(&(sign * b.1)).then(a.0.cmp(&b.0)));
     views.into_iter().map(|v| v.0).collect()
 }
 
 /// `heatmaps/ASSET/LOD/VV-METRIC.png`.
-pub fn heat_map_path(out: &Path, asset: &str, lod: &str, view: usize, metric: &str) -> PathBuf {
+pub fn heat_map_path(out: &Path, asset: &str, lod: &str, view: usize, metric: Metric) -> PathBuf {
     out.join("heatmaps")
         .join(asset)
         .join(lod)
@@ -634,7 +627,7 @@ fn write_heat_map(
     asset: &str,
     lod: &str,
     view: usize,
-    metric: &str,
+    metric: Metric,
     map: &crate::image::ErrorMap,
 ) -> Result<()> {
     let img = colormap::heat_map(&map.values, map.width, map.height, (map.height / 32).max(4));

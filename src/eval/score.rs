@@ -1,12 +1,9 @@
 //! Scoring one rendered view pair with the configured metric families: the reference (the
 //! original's render) is prepared once per view and compared with every LOD's render.
 //!
-//! Metric names written to `metrics.csv`:
-//! `flip` (FLIP mean), `flip_p95` (95th percentile of the per-pixel FLIP map), `flip_share` (share
-//! of pixels whose FLIP exceeds `flip_pixel_threshold`), `ssim`, `msssim` (sRGB luma, Wang et al.),
-//! `psnr` (dB, 8-bit sRGB over all three channels, as scikit-image, ffmpeg and idiff report it),
-//! `psnr_luminance` (dB) and `mse` (linear Rec. 709 luminance), `vdp` (detection probability)
-//! and `vdp_jnd`.
+//! Each family writes its metrics of `metric::catalog` (names, units and directions there): FLIP
+//! its mean, `flip_p95` and `flip_share` (pixels over `flip_pixel_threshold`); PSNR the 8-bit
+//! sRGB PSNR, luminance PSNR and MSE; the VDP its probability and JND.
 
 use std::borrow::Cow;
 
@@ -15,7 +12,7 @@ use super::tables::round7;
 use crate::error::Result;
 use crate::metric::flip::{Flip, FlipPrepared};
 use crate::metric::vdp::{Display, Vdp, VdpPrepared};
-use crate::metric::{ErrorMap, LinearImage, mse, pool, ssim};
+use crate::metric::{ErrorMap, LinearImage, Metric, mse, pool, ssim};
 use crate::scene::Viewing;
 
 /// The configured metrics at one viewing condition.
@@ -43,16 +40,16 @@ pub struct Reference {
 #[derive(Debug, Clone, Default)]
 pub struct Scored {
     /// (metric, value), rounded to 7 significant digits.
-    pub values: Vec<(&'static str, f64)>,
+    pub values: Vec<(Metric, f64)>,
     /// (metric, per-pixel map in [0, 1] where larger is worse).
-    pub maps: Vec<(&'static str, ErrorMap)>,
+    pub maps: Vec<(Metric, ErrorMap)>,
     /// The test image in 8-bit sRGB, where PSNR made it anyway.
     pub srgb8: Option<image::RgbImage>,
 }
 
 impl Scored {
     /// A value by metric name.
-    pub fn get(&self, metric: &str) -> Option<f64> {
+    pub fn get(&self, metric: Metric) -> Option<f64> {
         self.values.iter().find(|v| v.0 == metric).map(|v| v.1)
     }
 }
@@ -119,12 +116,16 @@ impl Scorer {
                         .compare_prepared(prepared, &self.flip.prepare(test))?;
                     let v = &s.map.values;
                     let over = v.iter().filter(|&&e| e > self.flip_pixel).count();
-                    out.values.push(("flip", round7(s.mean)));
-                    out.values
-                        .push(("flip_p95", round7(pool::percentile(v, 95.0))));
-                    out.values
-                        .push(("flip_share", round7(over as f64 / v.len().max(1) as f64)));
-                    out.maps.push(("flip", s.map));
+                    out.values.push((Metric::Flip, round7(s.mean)));
+                    out.values.push((
+                        Metric::FlipP95,
+                        round7(pool::percentile(v, 95.0).unwrap_or(0.0)),
+                    ));
+                    out.values.push((
+                        Metric::FlipShare,
+                        round7(over as f64 / v.len().max(1) as f64),
+                    ));
+                    out.maps.push((Metric::Flip, s.map));
                 }
                 MetricFamily::Ssim | MetricFamily::Msssim => {
                     // One pass gives SSIM and MS-SSIM's first scale: made at the first of the
@@ -142,13 +143,13 @@ impl Scorer {
                     let scores = ssim_scores.as_mut().expect("made above");
                     if family == MetricFamily::Msssim {
                         out.values
-                            .push(("msssim", round7(scores.ms.unwrap_or_default())));
+                            .push((Metric::Msssim, round7(scores.ms.unwrap_or_default())));
                         continue;
                     }
                     out.values
-                        .push(("ssim", round7(scores.mean.unwrap_or_default())));
+                        .push((Metric::Ssim, round7(scores.mean.unwrap_or_default())));
                     out.maps.push((
-                        "ssim",
+                        Metric::Ssim,
                         ErrorMap {
                             width: test.width(),
                             height: test.height(),
@@ -165,18 +166,18 @@ impl Scorer {
                     let test_encoded = test.to_srgb8();
                     let rgb = mse::psnr_srgb8_encoded(encoded, &test_encoded);
                     out.srgb8 = Some(test_encoded);
-                    out.values.push(("psnr", round7(rgb)));
-                    out.values.push(("psnr_luminance", round7(s.psnr_db)));
-                    out.values.push(("mse", round7(s.mse)));
+                    out.values.push((Metric::Psnr, round7(rgb)));
+                    out.values.push((Metric::PsnrLuminance, round7(s.psnr_db)));
+                    out.values.push((Metric::Mse, round7(s.mse)));
                 }
                 MetricFamily::Vdp => {
                     let prepared = reference.vdp.as_ref().expect("prepared with VDP");
                     let s = self
                         .vdp
                         .compare_prepared(prepared, &self.vdp.prepare(test))?;
-                    out.values.push(("vdp", round7(s.probability)));
-                    out.values.push(("vdp_jnd", round7(s.jnd)));
-                    out.maps.push(("vdp", s.map));
+                    out.values.push((Metric::Vdp, round7(s.probability)));
+                    out.values.push((Metric::VdpJnd, round7(s.jnd)));
+                    out.maps.push((Metric::Vdp, s.map));
                 }
             }
         }

@@ -17,6 +17,8 @@ use std::path::Path;
 use serde::{Deserialize, Serialize};
 
 use crate::error::Result;
+use crate::metric::Metric;
+use crate::metric::pool::percentile;
 
 /// One image pair and metric.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -29,9 +31,9 @@ pub struct MetricRow {
     pub triangles: usize,
     /// View number in the rig.
     pub view: usize,
-    /// Metric name (`flip`, `flip_p95`, `flip_share`, `ssim`, `msssim`, `psnr`, `mse`, `vdp`,
-    /// `vdp_jnd`).
-    pub metric: String,
+    /// The metric (its name from `metric::catalog`: `flip`, `flip_p95`, `flip_share`, `ssim`,
+    /// `msssim`, `psnr`, `psnr_luminance`, `mse`, `vdp`, `vdp_jnd`).
+    pub metric: Metric,
     /// Its value.
     pub value: f64,
     /// What rendered the pair: `cpu`, or `gpu: ADAPTER (DRIVER, API, TYPE)` (scores are computed
@@ -175,7 +177,7 @@ pub struct SummaryRow {
     /// LOD triangles over the original's.
     pub triangle_ratio: f64,
     /// Metric name.
-    pub metric: String,
+    pub metric: Metric,
     /// Mean over views.
     pub mean: f64,
     /// 95th percentile over views.
@@ -231,11 +233,6 @@ fn worst_of(
     })
 }
 
-/// Whether larger values of `metric` mean a larger difference.
-pub fn higher_is_worse(metric: &str) -> bool {
-    !matches!(metric, "ssim" | "msssim" | "psnr" | "psnr_luminance")
-}
-
 /// Round to 7 significant digits (see the module comment).
 pub fn round7(v: f64) -> f64 {
     if !v.is_finite() || v == 0.0 {
@@ -254,18 +251,11 @@ impl Results {
                 .unwrap_or(usize::MAX)
         };
         self.rows.sort_by(|x, y| {
-            (
-                pos(&x.asset, &x.lod),
-                x.view,
-                metric_rank(&x.metric),
-                &x.metric,
-            )
-                .cmp(&(
-                    pos(&y.asset, &y.lod),
-                    y.view,
-                    metric_rank(&y.metric),
-                    &y.metric,
-                ))
+            (pos(&x.asset, &x.lod), x.view, x.metric).cmp(&(
+                pos(&y.asset, &y.lod),
+                y.view,
+                y.metric,
+            ))
         });
         self.lods.sort_by_key(|l| pos(&l.asset, &l.lod));
         self.distances.sort_by(|x, y| {
@@ -276,15 +266,10 @@ impl Results {
     /// Per (asset, LOD, metric) statistics over views, in row order.
     pub fn summary(&self) -> Vec<SummaryRow> {
         let mut out: Vec<SummaryRow> = Vec::new();
-        type Key = (String, String, String, String);
+        type Key = (String, String, Metric, String);
         let mut groups: Vec<(Key, Vec<(usize, f64)>)> = Vec::new();
         for r in &self.rows {
-            let key = (
-                r.asset.clone(),
-                r.lod.clone(),
-                r.metric.clone(),
-                r.renderer.clone(),
-            );
+            let key = (r.asset.clone(), r.lod.clone(), r.metric, r.renderer.clone());
             match groups.iter_mut().find(|(k, _)| *k == key) {
                 Some((_, v)) => v.push((r.view, r.value)),
                 None => groups.push((key, vec![(r.view, r.value)])),
@@ -299,7 +284,7 @@ impl Results {
                 )
             });
             let vals: Vec<f64> = values.iter().map(|v| v.1).collect();
-            let worse = higher_is_worse(&metric);
+            let worse = metric.higher_is_worse();
             let worst_view = worst_of(values.iter().copied(), worse).map_or(0, |b| b.0);
             out.push(SummaryRow {
                 asset,
@@ -308,7 +293,7 @@ impl Results {
                 triangle_ratio: round7(ratio),
                 metric,
                 mean: round7(vals.iter().sum::<f64>() / vals.len() as f64),
-                p95: round7(percentile(&vals, 95.0)),
+                p95: round7(percentile(&vals, 95.0).expect("a group has a value")),
                 max: vals.iter().copied().fold(f64::NEG_INFINITY, f64::max),
                 worst_view,
                 renderer,
@@ -318,26 +303,26 @@ impl Results {
     }
 
     /// The worst per-view value of `metric` for one LOD, in the metric's direction.
-    pub fn worst(&self, asset: &str, lod: &str, metric: &str) -> Option<(usize, f64)> {
+    pub fn worst(&self, asset: &str, lod: &str, metric: Metric) -> Option<(usize, f64)> {
         worst_of(
             self.rows
                 .iter()
                 .filter(|r| r.asset == asset && r.lod == lod && r.metric == metric)
                 .map(|r| (r.view, r.value)),
-            higher_is_worse(metric),
+            metric.higher_is_worse(),
         )
     }
 
     /// The headline figures of one LOD, as the summary table and the report show them.
     pub fn headline(&self, asset: &str, lod: &str) -> Headline {
-        let worst = |m: &str| self.worst(asset, lod, m).map(|w| w.1);
+        let worst = |m: Metric| self.worst(asset, lod, m).map(|w| w.1);
         Headline {
-            flip_mean: self.mean(asset, lod, "flip"),
-            flip_worst: worst("flip"),
-            ssim_worst: worst("ssim"),
-            psnr_worst: worst("psnr"),
-            vdp_worst: worst("vdp"),
-            vdp_jnd_worst: worst("vdp_jnd"),
+            flip_mean: self.mean(asset, lod, Metric::Flip),
+            flip_worst: worst(Metric::Flip),
+            ssim_worst: worst(Metric::Ssim),
+            psnr_worst: worst(Metric::Psnr),
+            vdp_worst: worst(Metric::Vdp),
+            vdp_jnd_worst: worst(Metric::VdpJnd),
             distance: self
                 .distances
                 .iter()
@@ -347,7 +332,7 @@ impl Results {
     }
 
     /// The mean over views of `metric` for one LOD.
-    pub fn mean(&self, asset: &str, lod: &str, metric: &str) -> Option<f64> {
+    pub fn mean(&self, asset: &str, lod: &str, metric: Metric) -> Option<f64> {
         let v: Vec<f64> = self
             .rows
             .iter()
@@ -373,37 +358,6 @@ impl Results {
             distances: read_csv(&dir.join("distances.csv"))?,
         })
     }
-}
-
-fn metric_rank(m: &str) -> usize {
-    const ORDER: [&str; 10] = [
-        "flip",
-        "flip_p95",
-        "flip_share",
-        "ssim",
-        "msssim",
-        "psnr",
-        "psnr_luminance",
-        "mse",
-        "vdp",
-        "vdp_jnd",
-    ];
-    ORDER.iter().position(|o| *o == m).unwrap_or(ORDER.len())
-}
-
-/// Linear-interpolation percentile (NumPy's default) of unsorted values.
-pub fn percentile(values: &[f64], p: f64) -> f64 {
-    if values.is_empty() {
-        return f64::NAN;
-    }
-    let mut s = values.to_vec();
-    s.sort_by(f64::total_cmp);
-    let rank = p.clamp(0.0, 100.0) / 100.0 * (s.len() - 1) as f64;
-    let (lo, hi) = (rank.floor() as usize, rank.ceil() as usize);
-    if lo == hi || s[lo] == s[hi] {
-        return s[lo];
-    }
-    s[lo] + (s[hi] - s[lo]) * (rank - lo as f64)
 }
 
 /// A table row type and its CSV header (the README's schema; the serde field order must match).
@@ -496,7 +450,7 @@ mod tests {
             lod: lod.into(),
             triangles: 10,
             view,
-            metric: metric.into(),
+            metric: Metric::from_name(metric).expect("a metric name"),
             value,
             renderer: "cpu".into(),
         }
@@ -510,11 +464,11 @@ mod tests {
             r.rows.push(row("l", v, "ssim", s));
         }
         let s = r.summary();
-        let flip = s.iter().find(|x| x.metric == "flip").unwrap();
+        let flip = s.iter().find(|x| x.metric == Metric::Flip).unwrap();
         assert_eq!((flip.worst_view, flip.max), (1, 0.3));
         assert!((flip.mean - 0.2).abs() < 1e-12);
         assert!((flip.p95 - 0.29).abs() < 1e-12);
-        let ssim = s.iter().find(|x| x.metric == "ssim").unwrap();
+        let ssim = s.iter().find(|x| x.metric == Metric::Ssim).unwrap();
         assert_eq!(ssim.worst_view, 1);
     }
 

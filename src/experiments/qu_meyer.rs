@@ -19,6 +19,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::error::{Error, Result};
 use crate::mesh::{self, LoadOptions};
+use crate::metric::Metric;
 use crate::simplify::qu_meyer::{self, Method, Options};
 
 /// One model of the experiment.
@@ -239,7 +240,7 @@ pub fn run(config: &Path, log: &mut dyn FnMut(&str)) -> Result<Report> {
         },
         &crate::progress::Silent,
     )?;
-    let mean = |a: &str, l: &str, metric: &str| outcome.results.mean(a, l, metric).unwrap_or(0.0);
+    let mean = |a: &str, l: &str, metric: Metric| outcome.results.mean(a, l, metric).unwrap_or(0.0);
     let rows: Vec<Row> = made
         .iter()
         .map(|m| {
@@ -251,13 +252,13 @@ pub fn run(config: &Path, log: &mut dyn FnMut(&str)) -> Result<Report> {
                 vertices: m.vertices,
                 triangles: m.triangles,
                 masked_share: m.masked_share,
-                flip_mean: mean(&m.model, &lod, "flip"),
+                flip_mean: mean(&m.model, &lod, Metric::Flip),
                 flip_worst: outcome
                     .results
-                    .worst(&m.model, &lod, "flip")
+                    .worst(&m.model, &lod, Metric::Flip)
                     .map_or(0.0, |w| w.1),
-                vdp_jnd_mean: mean(&m.model, &lod, "vdp_jnd"),
-                vdp_mean: mean(&m.model, &lod, "vdp"),
+                vdp_jnd_mean: mean(&m.model, &lod, Metric::VdpJnd),
+                vdp_mean: mean(&m.model, &lod, Metric::Vdp),
                 seconds: m.seconds,
             }
         })

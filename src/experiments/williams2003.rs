@@ -23,12 +23,12 @@ use std::time::Instant;
 use serde::{Deserialize, Serialize};
 
 use crate::error::{Error, Result};
-use crate::eval::config::MetricFamily;
 use crate::eval::score::{Reference, Scorer};
 use crate::image::LinearImage;
 use crate::io::plot::{Series, line_plot};
 use crate::io::plot_png::Chart;
 use crate::mesh::{self, LoadOptions, Mesh};
+use crate::metric::{Metric, MetricFamily};
 use crate::raster::{self, Frame, RenderScene, RenderSettings, SamplePattern, Shading};
 use crate::scene::{Camera, Rig, Viewing};
 use crate::simplify::williams::{Criterion, Cut, Options, Williams};
@@ -219,8 +219,13 @@ fn score(
 ) -> Result<(f64, f64, f64, Frame)> {
     let frame = raster::render(&RenderScene::of(Arc::new(mesh)), camera, settings)?;
     let s = scorer.score(reference, &linear(&frame)?)?;
-    let get = |m: &str| s.get(m).unwrap_or(f64::NAN);
-    Ok((get("flip"), get("vdp"), get("vdp_jnd"), frame))
+    let get = |m: Metric| s.get(m).unwrap_or(f64::NAN);
+    Ok((
+        get(Metric::Flip),
+        get(Metric::Vdp),
+        get(Metric::VdpJnd),
+        frame,
+    ))
 }
 
 /// Run the experiment in `config`; `log` receives one line per finished curve.

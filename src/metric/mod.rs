@@ -1,4 +1,4 @@
-//! The perceptual difference stack: every metric takes two linear-RGB images of equal size
+//! The perceptual difference stack (`catalog.rs` names every reported value): every metric takes two linear-RGB images of equal size
 //! ([`LinearImage`]), is prepared once per reference where it has per-image work, and returns
 //! named results with units. One metric per file, in the order of the maths:
 //! `mse.rs` (MSE, PSNR, d_MS), `ssim.rs` (SSIM, MS-SSIM), `flip.rs` (ꟻLIP),
@@ -6,6 +6,7 @@
 //! (contrast sensitivity), `tvi.rs` (threshold versus intensity), `vdp/` (the visible-difference
 //! predictor, one stage per file).
 
+pub mod catalog;
 pub mod colormap;
 pub mod csf;
 pub mod flip;
@@ -20,3 +21,4 @@ pub mod vdp;
 // The metrics' input and output types live below the metric layer (`crate::image`); re-exported
 // here because every metric signature uses them.
 pub use crate::image::{ErrorMap, LinearImage};
+pub use catalog::{Metric, MetricFamily};

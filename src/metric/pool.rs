@@ -18,28 +18,32 @@ pub fn mean(values: &[f32], width: usize) -> f64 {
     rows.iter().sum::<f64>() / values.len() as f64
 }
 
-/// The `p`-th percentile (0..=100) by linear interpolation between closest ranks (NumPy's default).
-pub fn percentile(values: &[f32], p: f64) -> f64 {
+/// The `p`-th percentile (0..=100) by linear interpolation between closest ranks, exactly as
+/// NumPy's default (`numpy.percentile`, method "linear", including its two-sided interpolation
+/// formula); `None` for no values. The one percentile of lodeval: per-pixel maps (`f32`) and
+/// per-view tables (`f64`) both go through it.
+pub fn percentile<T: Copy + Into<f64>>(values: &[T], p: f64) -> Option<f64> {
     if values.is_empty() {
-        return 0.0;
+        return None;
     }
-    let mut v = values.to_vec();
+    let mut v: Vec<f64> = values.iter().map(|&x| x.into()).collect();
     let rank = p.clamp(0.0, 100.0) / 100.0 * (v.len() - 1) as f64;
     let (lo, hi) = (rank.floor() as usize, rank.ceil() as usize);
     let t = rank - lo as f64;
     // The lo-th and hi-th values in ascending (total) order, by selection rather than a sort:
-    // the hi-th is lo-th or the smallest of those after it.
-    let (_, &mut at_lo, above) = v.select_nth_unstable_by(lo, |a, b| a.total_cmp(b));
-    let at_hi = if hi == lo {
-        at_lo
+    // the hi-th is the lo-th or the smallest of those after it.
+    let (_, &mut a, above) = v.select_nth_unstable_by(lo, f64::total_cmp);
+    let b = if hi == lo {
+        a
     } else {
-        above
-            .iter()
-            .copied()
-            .min_by(|a, b| a.total_cmp(b))
-            .unwrap_or(at_lo)
+        above.iter().copied().min_by(f64::total_cmp).unwrap_or(a)
     };
-    at_lo as f64 * (1.0 - t) + at_hi as f64 * t
+    // NumPy's `_lerp`: from the lower end below the midpoint, from the upper end above it.
+    Some(if t < 0.5 {
+        a + (b - a) * t
+    } else {
+        b - (b - a) * (1.0 - t)
+    })
 }
 
 /// FLIP's weighted percentile (`p` in 0..=1): each value weighted by itself, so larger errors
@@ -96,8 +100,10 @@ mod tests {
     fn percentiles_interpolate_like_numpy() {
         // numpy.percentile([1, 2, 3, 4], 50) = 2.5 and 95 → 3.85.
         let v = [4.0, 1.0, 3.0, 2.0];
-        assert_eq!(percentile(&v, 50.0), 2.5);
-        assert!((percentile(&v, 95.0) - 3.85).abs() < 1e-12);
+        assert_eq!(percentile(&v, 50.0), Some(2.5));
+        assert!((percentile(&v, 95.0).unwrap() - 3.85).abs() < 1e-12);
+        assert_eq!(percentile::<f32>(&[], 50.0), None);
+        assert_eq!(percentile(&[7.0f64], 95.0), Some(7.0));
         assert_eq!(max(&v), 4.0);
         assert_eq!(mean(&v, 2), 2.5);
         assert_eq!(histogram(&[0.0, 0.5, 1.0], 2), vec![1, 2]);

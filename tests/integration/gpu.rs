@@ -86,7 +86,7 @@ fn parity(cpu: &Frame, gpu: &Frame, near: f32, far: f32) -> Parity {
     }
     Parity {
         flip_mean: flip.mean,
-        flip_p99: lodeval::metric::pool::percentile(&flip.map.values, 99.0),
+        flip_p99: lodeval::metric::pool::percentile(&flip.map.values, 99.0).unwrap(),
         differing: differing as f64 / interior.max(1) as f64,
         ids_differing: ids_differing as f64 / covered.max(1) as f64,
     }
