@@ -15,14 +15,17 @@ use crate::raster::{self, Frame, RenderSettings};
 use crate::scene::Camera;
 
 /// The user's choice.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, clap::ValueEnum)]
 pub enum Backend {
     /// The CPU reference (default: byte-identical results on every machine).
     #[default]
+    #[value(help = "The CPU reference rasterizer and metrics")]
     Cpu,
     /// The GPU mirror; an error without an adapter or without the `gpu` feature.
+    #[value(help = "The wgpu mirror (cargo feature `gpu`)")]
     Gpu,
     /// The GPU where possible, else the CPU.
+    #[value(help = "The GPU when built and an adapter exists, else the CPU")]
     Auto,
 }
 

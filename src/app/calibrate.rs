@@ -10,13 +10,20 @@ use crate::metric::vdp::modelfest::{Calibration, Condition, ModelFest};
 use crate::metric::vdp::{VdpParams, castle, foley, modelfest};
 
 /// Which human data to check against.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
 pub enum CalibrationSet {
     /// ModelFest's 43 thresholds.
+    #[value(
+        help = "ModelFest: 43 foveal detection thresholds of 16 observers (Carney et al. 1999)"
+    )]
     Modelfest,
     /// castleCSF's achromatic, static, foveal subset.
+    #[value(
+        help = "castleCSF's achromatic, static, foveal thresholds: 271 conditions from 9 datasets, 0.00002–10 000 cd/m², 0.003–980 deg² (Ashraf et al. 2024)"
+    )]
     Castle,
     /// Foley 1994's masking thresholds.
+    #[value(help = "Foley 1994: a Gabor's threshold on Gabor maskers at 0°, 45° and 90°")]
     Foley,
     /// All three.
     All,

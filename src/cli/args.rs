@@ -9,26 +9,6 @@ use lodeval::scene::{Lighting, Rig};
 use lodeval::{Error, LoadOptions, MissingAssets};
 
 #[derive(Copy, Clone, Debug, ValueEnum)]
-pub(crate) enum BackendArg {
-    /// The CPU reference rasterizer and metrics.
-    Cpu,
-    /// The wgpu mirror (cargo feature `gpu`).
-    Gpu,
-    /// The GPU when built and an adapter exists, else the CPU.
-    Auto,
-}
-
-impl From<BackendArg> for lodeval::backend::Backend {
-    fn from(b: BackendArg) -> Self {
-        match b {
-            BackendArg::Cpu => Self::Cpu,
-            BackendArg::Gpu => Self::Gpu,
-            BackendArg::Auto => Self::Auto,
-        }
-    }
-}
-
-#[derive(Copy, Clone, Debug, ValueEnum)]
 pub(crate) enum PatternArg {
     /// Rotated ("n-rooks") grid.
     Rotated,
@@ -49,19 +29,11 @@ impl PatternArg {
 #[derive(Args, Debug)]
 pub(crate) struct LoadArgs {
     /// What to do when a texture or material library is missing or undecodable.
-    #[arg(long, value_enum, default_value_t = MissingArg::Error)]
-    pub(crate) missing_assets: MissingArg,
+    #[arg(long, value_enum, default_value_t = MissingAssets::Error)]
+    pub(crate) missing_assets: MissingAssets,
     /// Crease angle in degrees for computed normals (180 = smooth everywhere).
     #[arg(long, default_value_t = 180.0, value_name = "DEGREES")]
     pub(crate) crease_angle: f32,
-}
-
-#[derive(Copy, Clone, Debug, ValueEnum)]
-pub(crate) enum MissingArg {
-    /// Fail with a message naming the file.
-    Error,
-    /// Warn and render with the material's base colour.
-    Warn,
 }
 
 impl LoadArgs {
@@ -73,10 +45,7 @@ impl LoadArgs {
             )));
         }
         let mut o = LoadOptions::DEFAULT;
-        o.missing_assets = match self.missing_assets {
-            MissingArg::Error => MissingAssets::Error,
-            MissingArg::Warn => MissingAssets::Warn,
-        };
+        o.missing_assets = self.missing_assets;
         o.crease_angle_deg = self.crease_angle;
         Ok(o)
     }

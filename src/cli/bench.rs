@@ -3,10 +3,11 @@
 use std::path::PathBuf;
 
 use clap::{Args, ValueEnum};
+use lodeval::backend::Backend;
 use lodeval::raster::Shading;
 use lodeval::{Error, LoadOptions};
 
-use super::args::{BackendArg, count, parse_samples, parse_shading};
+use super::args::{count, parse_samples, parse_shading};
 use super::print::{emit, emit_json};
 
 /// What `lodeval bench` measures.
@@ -82,8 +83,8 @@ pub(crate) struct BenchArgs {
     #[arg(long)]
     pub(crate) export: Option<PathBuf>,
     /// Renderer to time: cpu, gpu or auto.
-    #[arg(long, value_enum, default_value_t = BackendArg::Cpu)]
-    pub(crate) backend: BackendArg,
+    #[arg(long, value_enum, default_value_t = Backend::Cpu)]
+    pub(crate) backend: Backend,
 }
 
 /// Load each mesh, named by its file stem (for the benchmarks' tables).

@@ -2,24 +2,11 @@
 
 use std::path::PathBuf;
 
-use clap::{Args, ValueEnum};
+use clap::Args;
 use lodeval::Error;
+use lodeval::app::CalibrationSet;
 
 use super::print::{emit, emit_json};
-
-/// Datasets `lodeval calibrate` knows.
-#[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
-pub(crate) enum CalibrationSet {
-    /// ModelFest: 43 foveal detection thresholds of 16 observers (Carney et al. 1999).
-    Modelfest,
-    /// castleCSF's achromatic, static, foveal thresholds: 271 conditions from 9 datasets,
-    /// 0.00002–10 000 cd/m², 0.003–980 deg² (Ashraf et al. 2024).
-    Castle,
-    /// Foley 1994: a Gabor's threshold on Gabor maskers at 0°, 45° and 90°.
-    Foley,
-    /// All three.
-    All,
-}
 
 #[derive(Args, Debug)]
 #[command(
@@ -56,12 +43,7 @@ pub(crate) struct CalibrateArgs {
 /// Run `calibrate`.
 pub(crate) fn run(a: CalibrateArgs) -> Result<(), Error> {
     use lodeval::app::CalibrationSet as S;
-    let set = match a.set {
-        CalibrationSet::Modelfest => S::Modelfest,
-        CalibrationSet::Castle => S::Castle,
-        CalibrationSet::Foley => S::Foley,
-        CalibrationSet::All => S::All,
-    };
+    let set = a.set;
     if a.dataset.is_some() && !matches!(set, S::Castle | S::All) {
         return Err(Error::Usage(
             "--dataset picks one of castleCSF's datasets: use it with `calibrate castle`".into(),

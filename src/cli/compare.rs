@@ -5,10 +5,11 @@ use std::path::PathBuf;
 
 use clap::Args;
 use lodeval::Error;
+use lodeval::backend::Backend;
 use lodeval::eval::compare::{CompareJob, CompareReport};
 use lodeval::metric::Metric;
 
-use super::args::{BackendArg, LookArgs, count, parse_shading};
+use super::args::{LookArgs, count, parse_shading};
 use super::print::{emit, emit_json, warnings};
 use super::progress::Reporter;
 
@@ -32,8 +33,8 @@ pub(crate) struct CompareArgs {
     #[arg(long)]
     pub(crate) no_distances: bool,
     /// Where to render: cpu (the reference), gpu or auto.
-    #[arg(long, value_enum, default_value_t = BackendArg::Cpu)]
-    pub(crate) backend: BackendArg,
+    #[arg(long, value_enum, default_value_t = Backend::Cpu)]
+    pub(crate) backend: Backend,
     /// Print JSON: every view's scores, the summary and the distances.
     #[arg(long)]
     pub(crate) json: bool,

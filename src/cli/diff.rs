@@ -5,9 +5,10 @@ use std::path::PathBuf;
 use clap::Args;
 use lodeval::Error;
 use lodeval::app::MetricChoice;
+use lodeval::backend::Backend;
 use lodeval::metric::Metric;
 
-use super::args::{BackendArg, value};
+use super::args::value;
 use super::print::{emit, emit_json, warnings};
 
 #[derive(Args, Debug)]
@@ -18,8 +19,8 @@ pub(crate) struct DiffArgs {
     /// Reference image (PNG/JPEG: sRGB; EXR: linear).
     pub(crate) reference: PathBuf,
     /// Where FLIP, MSE and PSNR run: cpu, gpu (compute kernels) or auto.
-    #[arg(long, value_enum, default_value_t = BackendArg::Cpu)]
-    pub(crate) backend: BackendArg,
+    #[arg(long, value_enum, default_value_t = Backend::Cpu)]
+    pub(crate) backend: Backend,
     /// Test image(s), each the reference's size; each is compared with the reference.
     #[arg(required = true, num_args = 1..)]
     pub(crate) test: Vec<PathBuf>,

@@ -4,8 +4,8 @@ use std::path::PathBuf;
 
 use clap::Args;
 use lodeval::Error;
+use lodeval::backend::Backend;
 
-use super::args::BackendArg;
 use super::print::gate_result;
 use super::progress::Reporter;
 
@@ -24,8 +24,8 @@ pub(crate) struct EvalArgs {
     #[arg(long, value_name = "INDEX/COUNT")]
     pub(crate) shard: Option<String>,
     /// Renderer and FLIP/MSE kernels: cpu, gpu or auto (recorded in the CSVs and the report).
-    #[arg(long, value_enum, default_value_t = BackendArg::Cpu)]
-    pub(crate) backend: BackendArg,
+    #[arg(long, value_enum, default_value_t = Backend::Cpu)]
+    pub(crate) backend: Backend,
     /// Keep the originals' frames in this folder, keyed by a hash of the mesh files, the scene,
     /// the settings, the camera and this build, and reuse them (same outputs, fewer renders).
     #[arg(long, value_name = "DIR")]

@@ -3,21 +3,13 @@
 
 use std::path::PathBuf;
 
-use clap::{Args, ValueEnum};
+use clap::Args;
 use lodeval::Error;
+use lodeval::simplify::lindstrom_turk::Normals;
 
 use super::args::count;
 use super::print::emit;
 use super::progress::Reporter;
-
-/// `--normals`.
-#[derive(Copy, Clone, Debug, PartialEq, Eq, ValueEnum)]
-pub(crate) enum NormalsArg {
-    /// Recomputed from the geometry after every change.
-    Derived,
-    /// Optimized as free attributes.
-    Free,
-}
 
 #[derive(Args, Debug)]
 #[command(
@@ -49,8 +41,8 @@ pub(crate) struct OptimizeArgs {
     #[arg(long, default_value_t = 1)]
     pub(crate) seed: u64,
     /// Normals: derived (from the geometry) or free (optimized as attributes).
-    #[arg(long, value_enum, default_value_t = NormalsArg::Derived)]
-    pub(crate) normals: NormalsArg,
+    #[arg(long, value_enum, default_value_t = Normals::Derived)]
+    pub(crate) normals: Normals,
     /// Do not optimize UVs and colours.
     #[arg(long)]
     pub(crate) no_attributes: bool,
@@ -61,7 +53,7 @@ pub(crate) struct OptimizeArgs {
 
 /// Run `optimize`.
 pub(crate) fn run(a: OptimizeArgs, quiet: bool) -> Result<(), Error> {
-    use lodeval::simplify::lindstrom_turk::{Normals, Options};
+    use lodeval::simplify::lindstrom_turk::Options;
     if let Some(config) = &a.experiment {
         let rows = lodeval::experiments::lindstrom_turk::run(config, &mut |line| {
             if !quiet {
@@ -81,10 +73,7 @@ pub(crate) fn run(a: OptimizeArgs, quiet: bool) -> Result<(), Error> {
             "give ORIGINAL SIMPLIFIED -o OUT, or --experiment CONFIG".into(),
         ));
     };
-    let normals = match a.normals {
-        NormalsArg::Derived => Normals::Derived,
-        NormalsArg::Free => Normals::Free,
-    };
+    let normals = a.normals;
     if a.views == 0 || a.size < 8 || a.size > 4096 {
         return Err(Error::Usage(
             "--views must be at least 1 and --size within 8..4096".into(),

@@ -3,33 +3,11 @@
 
 use std::path::PathBuf;
 
-use clap::{Args, ValueEnum};
+use clap::Args;
 use lodeval::Error;
 use lodeval::simplify::qu_meyer::{Method, Options};
 
 use super::print::{emit, emit_json};
-
-/// `--method`.
-#[derive(Copy, Clone, Debug, PartialEq, Eq, ValueEnum)]
-pub(crate) enum RemeshMethodArg {
-    /// Curvature and the visual masking map of the surface signal (the paper's method).
-    #[value(name = "qu-meyer")]
-    QuMeyer,
-    /// Curvature only (--perceptual-gamma 0).
-    Curvature,
-    /// Uniform on the surface (both gammas 0; the paper's baseline).
-    Uniform,
-}
-
-impl RemeshMethodArg {
-    fn method(self) -> Method {
-        match self {
-            RemeshMethodArg::QuMeyer => Method::QuMeyer,
-            RemeshMethodArg::Curvature => Method::Curvature,
-            RemeshMethodArg::Uniform => Method::Uniform,
-        }
-    }
-}
 
 #[derive(Args, Debug)]
 #[command(
@@ -51,8 +29,8 @@ pub(crate) struct RemeshArgs {
     #[arg(long, required_unless_present = "experiment")]
     pub(crate) vertices: Option<usize>,
     /// The density: qu-meyer (curvature and masking), curvature, or uniform.
-    #[arg(long, value_enum, default_value_t = RemeshMethodArg::QuMeyer)]
-    pub(crate) method: RemeshMethodArg,
+    #[arg(long, value_enum, default_value_t = Method::QuMeyer)]
+    pub(crate) method: Method,
     /// Weight of the curvature map (0 to 10; the paper's figures use 1.2).
     #[arg(long, default_value_t = 1.2, allow_negative_numbers = true)]
     pub(crate) curvature_gamma: f64,
@@ -96,7 +74,7 @@ pub(crate) fn run(a: RemeshArgs, quiet: bool) -> Result<(), Error> {
         ));
     };
     let mut options = Options::new(vertices);
-    options.method = a.method.method();
+    options.method = a.method;
     options.curvature_gamma = a.curvature_gamma;
     options.perceptual_gamma = a.perceptual_gamma;
     options.lloyd_iterations = a.lloyd_iterations;

@@ -6,12 +6,12 @@ use std::path::PathBuf;
 use clap::Args;
 use lodeval::Error;
 use lodeval::app::{RenderJob, ViewSelection};
+use lodeval::backend::Backend;
 use lodeval::raster::{RenderSettings, Shading};
 use lodeval::scene::Rig;
 
 use super::args::{
-    BackendArg, LoadArgs, LookArgs, PatternArg, count, parse_rig, parse_samples, parse_shading,
-    side,
+    LoadArgs, LookArgs, PatternArg, count, parse_rig, parse_samples, parse_shading, side,
 };
 use super::print::warnings;
 
@@ -65,8 +65,8 @@ pub(crate) struct RenderArgs {
     pub(crate) cameras: Option<PathBuf>,
     /// Renderer: cpu (the reference), gpu (the wgpu mirror; needs the `gpu` feature and an
     /// adapter) or auto (gpu when available).
-    #[arg(long, value_enum, default_value_t = BackendArg::Cpu)]
-    pub(crate) backend: BackendArg,
+    #[arg(long, value_enum, default_value_t = Backend::Cpu)]
+    pub(crate) backend: Backend,
     #[command(flatten)]
     pub(crate) load: LoadArgs,
     #[command(flatten)]

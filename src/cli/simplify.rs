@@ -3,7 +3,7 @@
 
 use std::path::PathBuf;
 
-use clap::{Args, ValueEnum};
+use clap::Args;
 use lodeval::Error;
 use lodeval::raster::Shading;
 use lodeval::scene::Rig;
@@ -13,66 +13,6 @@ use lodeval::simplify::williams::Criterion;
 use super::args::{LookArgs, count, parse_rig, parse_shading};
 use super::print::{emit, emit_json};
 use super::progress::Reporter;
-
-/// `--method`.
-#[derive(Copy, Clone, Debug, PartialEq, Eq, ValueEnum)]
-pub(crate) enum MethodArg {
-    /// Our edge collapse with Garland–Heckbert quadrics.
-    Qem,
-    /// Rossignac–Borrel vertex clustering.
-    Cluster,
-    /// meshoptimizer's index-only simplification.
-    Meshopt,
-    /// meshoptimizer moving vertices and attributes, as qem does.
-    #[value(name = "meshopt-update")]
-    MeshoptUpdate,
-    /// Williams et al. 2003: perceptual, view-dependent, to a --budget or --distance.
-    Williams,
-    /// Menzel & Guthe 2010: each collapse tested for imperceptibility in vertex space, to a
-    /// --distance, --error, --ratio or --triangles.
-    #[value(name = "menzel-guthe")]
-    MenzelGuthe,
-}
-
-impl MethodArg {
-    /// The library's method.
-    fn method(self) -> Method {
-        match self {
-            MethodArg::Qem => Method::Qem,
-            MethodArg::Cluster => Method::Cluster,
-            MethodArg::Meshopt => Method::Meshopt,
-            MethodArg::MeshoptUpdate => Method::MeshoptUpdate,
-            MethodArg::Williams => Method::Williams,
-            MethodArg::MenzelGuthe => Method::MenzelGuthe,
-        }
-    }
-}
-
-/// `--criterion` (Williams et al. §6's comparisons).
-#[derive(Copy, Clone, Debug, PartialEq, Eq, ValueEnum)]
-pub(crate) enum CriterionArg {
-    /// The paper's imperceptibility distance.
-    Perceptual,
-    /// View-independent object-space texture deviation.
-    ObjectSpace,
-    /// Texture deviation projected to pixels.
-    ScreenSpace,
-    /// Screen-space deviation, ×10 on the silhouette.
-    #[value(name = "silhouette-10")]
-    Silhouette10,
-}
-
-impl CriterionArg {
-    /// The library's criterion.
-    fn criterion(self) -> Criterion {
-        match self {
-            CriterionArg::Perceptual => Criterion::Perceptual,
-            CriterionArg::ObjectSpace => Criterion::ObjectSpace,
-            CriterionArg::ScreenSpace => Criterion::ScreenSpace,
-            CriterionArg::Silhouette10 => Criterion::Silhouette10,
-        }
-    }
-}
 
 #[derive(Args, Debug)]
 #[command(
@@ -92,8 +32,8 @@ pub(crate) struct SimplifyArgs {
     /// qem (our edge collapse, Garland–Heckbert quadrics), cluster (Rossignac–Borrel), meshopt,
     /// meshopt-update (meshoptimizer moving vertices and attributes, as qem does), or williams
     /// (Williams et al. 2003: perceptual, view-dependent, to a --budget).
-    #[arg(long, value_enum, default_value_t = MethodArg::Qem)]
-    pub(crate) method: MethodArg,
+    #[arg(long, value_enum, default_value_t = Method::Qem)]
+    pub(crate) method: Method,
     /// williams: triangle budget.
     #[arg(long, conflicts_with_all = ["ratio", "triangles", "error", "chain", "distance"])]
     pub(crate) budget: Option<usize>,
@@ -127,7 +67,7 @@ pub(crate) struct SimplifyArgs {
     pub(crate) look: LookArgs,
     /// williams: perceptual (default), object-space, screen-space or silhouette-10.
     #[arg(long, value_enum)]
-    pub(crate) criterion: Option<CriterionArg>,
+    pub(crate) criterion: Option<Criterion>,
     /// williams: image size the views are rendered at (pixels; default 512).
     #[arg(long, value_parser = count::<u32>(&lodeval::limits::IMAGE_SIDE))]
     pub(crate) size: Option<u32>,
@@ -169,7 +109,7 @@ pub(crate) fn run(a: SimplifyArgs, quiet: bool) -> Result<(), Error> {
         note!("{} curve points written", rows.len());
         return Ok(());
     }
-    if a.method == MethodArg::Williams {
+    if a.method == Method::Williams {
         let report = lodeval::app::simplify_williams(&williams_job(&a)?)?;
         super::print::warnings(&report.warnings);
         if a.json {
@@ -200,11 +140,11 @@ pub(crate) fn run(a: SimplifyArgs, quiet: bool) -> Result<(), Error> {
         super::print::warnings(&[format!(
             "{} apply to --method williams only; they do nothing with {}",
             williams_only.join(", "),
-            a.method.method().name()
+            a.method.name()
         )]);
     }
     use lodeval::simplify::Goal;
-    let method = a.method.method();
+    let method = a.method;
     let unit = |r: f64, what: &str| {
         if r > 0.0 && r <= 1.0 {
             Ok(r)
@@ -372,7 +312,7 @@ pub(crate) fn williams_job(a: &SimplifyArgs) -> Result<lodeval::app::WilliamsJob
             }
             s => s,
         },
-        criterion: a.criterion.unwrap_or(CriterionArg::Perceptual).criterion(),
+        criterion: a.criterion.unwrap_or(Criterion::Perceptual),
         size: a.size.unwrap_or(512),
     })
 }

@@ -97,13 +97,15 @@ impl Format {
 }
 
 /// What to do when a referenced texture or material library is missing or cannot be decoded.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, clap::ValueEnum)]
 #[non_exhaustive]
 pub enum MissingAssets {
     /// Fail with an input error naming the file (the default).
     #[default]
+    #[value(help = "Fail with a message naming the file")]
     Error,
     /// Keep the material's base colour and record a warning in [`Mesh::warnings`].
+    #[value(help = "Warn and render with the material's base colour")]
     Warn,
 }
 

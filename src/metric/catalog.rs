@@ -111,7 +111,7 @@ pub const CATALOG: [Entry; 10] = [
     Entry {
         metric: Metric::FlipShare,
         name: "flip_share",
-        what: "share of pixels whose ꟻLIP exceeds the per-pixel level",
+        what: "Share of pixels whose ꟻLIP exceeds the per-pixel level",
         unit: "",
         worse: Worse::Higher,
         range: UNIT,
@@ -133,7 +133,7 @@ pub const CATALOG: [Entry; 10] = [
     Entry {
         metric: Metric::Msssim,
         name: "msssim",
-        what: "multi-scale SSIM on sRGB luma (images of at least 176×176)",
+        what: "Multi-scale SSIM on sRGB luma (images of at least 176×176)",
         unit: "",
         worse: Worse::Lower,
         range: (-1.0, 1.0),
@@ -178,7 +178,7 @@ pub const CATALOG: [Entry; 10] = [
     Entry {
         metric: Metric::Vdp,
         name: "vdp",
-        what: "the visible-difference predictor: detection probability in [0, 1] (and JND)",
+        what: "The visible-difference predictor: detection probability in [0, 1] (and JND)",
         unit: "",
         worse: Worse::Higher,
         range: UNIT,
@@ -189,7 +189,7 @@ pub const CATALOG: [Entry; 10] = [
     Entry {
         metric: Metric::VdpJnd,
         name: "vdp_jnd",
-        what: "the visible-difference predictor's difference in just-noticeable differences",
+        what: "The visible-difference predictor's difference in just-noticeable differences",
         unit: "JND",
         worse: Worse::Higher,
         range: (0.0, f64::INFINITY),

@@ -35,28 +35,38 @@ pub(crate) fn read_experiment<T: serde::de::DeserializeOwned>(
 }
 
 /// A simplification method.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Deserialize, serde::Serialize)]
+#[derive(
+    Debug, Clone, Copy, PartialEq, Eq, serde::Deserialize, serde::Serialize, clap::ValueEnum,
+)]
 #[serde(rename_all = "lowercase")]
 pub enum Method {
     /// Our edge collapse with Garland–Heckbert 1997 quadrics.
+    #[value(help = "Our edge collapse with Garland–Heckbert quadrics")]
     Qem,
     /// Rossignac–Borrel vertex clustering.
     Cluster,
     /// meshoptimizer's `simplify`.
+    #[value(help = "meshoptimizer's index-only simplification")]
     Meshopt,
     /// meshoptimizer's `simplifyWithUpdate`: attribute-aware, moves the kept vertices.
     #[serde(rename = "meshopt-update")]
+    #[value(help = "meshoptimizer moving vertices and attributes, as qem does")]
     MeshoptUpdate,
     /// Williams et al. 2003 perceptual budget refinement: one static LOD for the 20 views of the
     /// default rig (each node keyed by its worst view), Gouraud shading, default viewing.
+    #[value(help = "Williams et al. 2003: perceptual, view-dependent, to a --budget or --distance")]
     Williams,
     /// Menzel & Guthe 2010: collapses tested in vertex space for imperceptibility, with the
     /// distance beyond which each is invisible (`menzel_guthe/`).
     #[serde(rename = "menzel-guthe")]
+    #[value(
+        help = "Menzel & Guthe 2010: each collapse tested for imperceptibility in vertex space, to a --distance, --error, --ratio or --triangles"
+    )]
     MenzelGuthe,
     /// Qu & Meyer: a remesh of a textured mesh to a vertex count, placed by curvature and the
     /// visual masking of its surface signal (`qu_meyer/`; vertex goals only).
     #[serde(rename = "qu-meyer")]
+    #[value(skip)] // `lodeval remesh`, not `simplify`
     QuMeyer,
 }
 

@@ -17,12 +17,16 @@ use crate::mesh::edit::{Adjacency, Undo, Wedge};
 use crate::raster::incremental::{Change, LumaViews};
 
 /// How normals are treated.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Deserialize, serde::Serialize)]
+#[derive(
+    Debug, Clone, Copy, PartialEq, Eq, serde::Deserialize, serde::Serialize, clap::ValueEnum,
+)]
 #[serde(rename_all = "lowercase")]
 pub enum Normals {
     /// Recomputed from the geometry after every change (area-weighted, per wedge).
+    #[value(help = "Recomputed from the geometry after every change")]
     Derived,
     /// Optimized as free attributes by the simplex.
+    #[value(help = "Optimized as free attributes")]
     Free,
 }
 

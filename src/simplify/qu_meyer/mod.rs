@@ -51,13 +51,18 @@ use self::density::{Density, apportion};
 use self::maps::Maps;
 
 /// Which density drives the samples.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
 pub enum Method {
     /// Curvature and the masking map (the paper's method).
+    #[value(
+        help = "Curvature and the visual masking map of the surface signal (the paper's method)"
+    )]
     QuMeyer,
     /// Curvature only (the perceptual gamma 0).
+    #[value(help = "Curvature only (--perceptual-gamma 0)")]
     Curvature,
     /// Neither: uniform on the surface (both gammas 0; the paper's baseline).
+    #[value(help = "Uniform on the surface (both gammas 0; the paper's baseline)")]
     Uniform,
 }
 

@@ -38,17 +38,22 @@ use crate::scene::{Camera, Light, Projection, Viewing};
 pub const PEAK_SENSITIVITY: f64 = 250.0;
 
 /// The error criterion the budget refinement minimises.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, serde::Deserialize, serde::Serialize)]
+#[derive(
+    Debug, Clone, Copy, PartialEq, Eq, Hash, serde::Deserialize, serde::Serialize, clap::ValueEnum,
+)]
 #[serde(rename_all = "kebab-case")]
 pub enum Criterion {
     /// Williams et al.: imperceptibility distance.
+    #[value(help = "The paper's imperceptibility distance")]
     Perceptual,
     /// View-independent object-space texture deviation.
     ObjectSpace,
     /// Texture deviation projected to pixels (view-dependent APS).
+    #[value(help = "Texture deviation projected to pixels")]
     ScreenSpace,
     /// Screen-space deviation, ×10 on the silhouette.
     #[serde(rename = "silhouette-10")]
+    #[value(name = "silhouette-10")]
     Silhouette10,
 }
 
