@@ -111,16 +111,8 @@ fn main() {
         let original = RenderScene::of(Arc::new(mesh));
         for (lod, ratio) in lods.into_iter().zip(ratios) {
             let scene = RenderScene::of(Arc::new(lod.mesh));
-            let job = DistanceJob {
-                original: &original,
-                lod: &scene,
-                directions: directions.clone(),
-                meters_per_unit: 1.0,
-                simplifier_error: None,
-                names: (name, "lod", 0),
-                switch_m: None,
-                originals: None,
-            };
+            let mut job = DistanceJob::new(&original, &scene, directions.clone());
+            job.names = (name, "lod", 0);
             let (mut ours, mut theirs) = (Vec::new(), vec![Vec::new(); JOD_STEPS.len()]);
             for size in SIZES {
                 let views = probe_views(&job, &viewing, &settings, SampleCount(16), size as f64)

@@ -22,19 +22,26 @@
 //! writes `metrics.csv`, `summary.csv`, `distances.csv`, heat maps, plots and `report.html`, and its
 //! gate decides the exit code. Colour conversions live in [`color`].
 
+#[doc(hidden)]
+// the binary's jobs and the papers' runs, public for the CLI and tests; not a library API
 pub mod app;
 pub mod backend;
 pub mod color;
+#[doc(hidden)] // plumbing shared with the binary (files, bounds); not a library API
 pub mod cpu;
 pub mod error;
 pub mod eval;
+#[doc(hidden)]
+// the binary's jobs and the papers' runs, public for the CLI and tests; not a library API
 pub mod experiments;
 #[cfg(feature = "gpu")]
 pub mod gpu;
 pub mod image;
+#[doc(hidden)] // plumbing shared with the binary (files, bounds); not a library API
 pub mod io;
 #[cfg(test)]
 mod layers;
+#[doc(hidden)] // plumbing shared with the binary (files, bounds); not a library API
 pub mod limits;
 pub mod mesh;
 pub mod metric;
@@ -44,10 +51,16 @@ pub mod raster;
 pub mod scene;
 pub mod simplify;
 
-// What a library user reaches for first, at the crate root.
+// What a library user reaches for first, at the crate root: load a mesh, simplify it, render
+// both, score the pair, or run a whole config.
 pub use error::{Error, Location, Result};
-pub use eval::{Plan, Results, RunOptions};
+pub use eval::compare::{CompareJob, CompareReport, compare};
+pub use eval::{Outcome, Plan, Results, RunOptions, eval};
 pub use image::{ErrorMap, LinearImage};
-pub use mesh::{LoadOptions, Mesh, MeshSummary, MissingAssets};
-pub use raster::{Frame, RenderScene};
+pub use mesh::{LoadOptions, Mesh, MeshSummary, MissingAssets, load};
+pub use metric::flip::Flip;
+pub use metric::vdp::{Display, Vdp};
+pub use metric::{Metric, MetricFamily};
+pub use raster::{Frame, RenderScene, RenderSettings, Shading, render};
 pub use scene::{Camera, Rig, Viewing};
+pub use simplify::{Goal, Lod, Method, chain};

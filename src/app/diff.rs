@@ -187,6 +187,7 @@ pub fn judge(r: &DiffResult, gates: &DiffGates) -> (Option<String>, Option<Strin
 
 /// What `diff` writes and how it treats metrics that do not apply.
 #[derive(Debug, Clone, Copy, Default)]
+#[non_exhaustive]
 pub struct DiffOptions<'a> {
     /// Heat map path (see [`diff`]).
     pub map: Option<&'a Path>,
@@ -196,6 +197,16 @@ pub struct DiffOptions<'a> {
     pub pixel_threshold: Option<f64>,
     /// HDR-FLIP's exposure range for EXR pairs (else the automatic one).
     pub exposures: Option<crate::metric::hdr_flip::Exposures>,
+}
+
+impl DiffOptions<'_> {
+    /// No heat map, strict about sizes, no per-pixel threshold, automatic HDR exposures.
+    pub const DEFAULT: DiffOptions<'static> = DiffOptions {
+        map: None,
+        lenient: false,
+        pixel_threshold: None,
+        exposures: None,
+    };
 }
 
 /// Where and on what the compared images are seen.

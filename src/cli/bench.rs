@@ -264,7 +264,7 @@ pub(crate) fn run(a: BenchArgs) -> Result<(), Error> {
         samples: a.samples,
         shading: a.shading,
         export: a.export,
-        backend: a.backend.into(),
+        backend: a.backend,
     };
     let rows = lodeval::app::bench::bench_raster(&job)?;
     let rss = lodeval::app::bench::peak_rss_mib().unwrap_or(f64::NAN);

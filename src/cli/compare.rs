@@ -48,15 +48,12 @@ pub(crate) struct CompareArgs {
 
 /// Run `compare`.
 pub(crate) fn run(a: CompareArgs, quiet: bool) -> Result<(), Error> {
-    let job = CompareJob {
-        original: a.original,
-        lod: a.lod,
-        views: a.views,
-        size: a.size,
-        distances: !a.no_distances,
-        backend: a.backend.into(),
-        look: a.look.look(a.shading),
-    };
+    let mut job = CompareJob::new(a.original, a.lod);
+    job.views = a.views;
+    job.size = a.size;
+    job.distances = !a.no_distances;
+    job.backend = a.backend;
+    job.look = a.look.look(a.shading);
     let report = lodeval::eval::compare::compare(&job, &Reporter::new(quiet || a.json))?;
     warnings(&report.warnings);
     if a.json {

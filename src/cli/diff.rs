@@ -133,7 +133,7 @@ pub(crate) fn run(a: DiffArgs) -> Result<(), Error> {
     viewing.check().map_err(Error::Usage)?;
     // With `all`, metrics that do not apply to this image size report a note instead.
     let lenient = a.metric.0.is_none();
-    let engine = lodeval::backend::Engine::new(a.backend.into())?;
+    let engine = lodeval::backend::Engine::new(a.backend)?;
     warnings(
         &engine
             .fallback()
@@ -189,24 +189,16 @@ pub(crate) fn run(a: DiffArgs) -> Result<(), Error> {
                 m.clone()
             }
         });
-        let results = lodeval::app::diff(
-            &engine,
-            &a.reference,
-            test,
-            &metrics,
-            &seen,
-            &lodeval::app::DiffOptions {
-                map: map.as_deref(),
-                lenient,
-                pixel_threshold: a.fail_pixel,
-                exposures: match (a.start_exposure, a.stop_exposure, a.num_exposures) {
-                    (Some(start), Some(stop), Some(count)) => {
-                        Some(lodeval::metric::hdr_flip::Exposures { start, stop, count })
-                    }
-                    _ => None,
-                },
-            },
-        )?;
+        let mut options = lodeval::app::DiffOptions::DEFAULT;
+        options.map = map.as_deref();
+        options.lenient = lenient;
+        options.pixel_threshold = a.fail_pixel;
+        if let (Some(start), Some(stop), Some(count)) =
+            (a.start_exposure, a.stop_exposure, a.num_exposures)
+        {
+            options.exposures = Some(lodeval::metric::hdr_flip::Exposures { start, stop, count });
+        }
+        let results = lodeval::app::diff(&engine, &a.reference, test, &metrics, &seen, &options)?;
         let gate_row = results.iter().find(|r| r.metric == gated);
         let (fail, warn) = gate_row.map_or((None, None), |r| lodeval::app::judge(r, &gates));
         all.push((test.clone(), results, fail, warn));

@@ -39,12 +39,11 @@ pub(crate) fn run(a: EvalArgs, quiet: bool) -> Result<(), Error> {
         None => lodeval::eval::Shard::from_env(|k| std::env::var(k).ok())?
             .unwrap_or(lodeval::eval::Shard::ALL),
     };
-    let options = lodeval::eval::RunOptions {
-        out: a.out,
-        shard,
-        backend: a.backend.into(),
-        cache: a.cache,
-    };
+    let mut options = lodeval::eval::RunOptions::DEFAULT;
+    options.out = a.out;
+    options.shard = shard;
+    options.backend = a.backend;
+    options.cache = a.cache;
     let outcome = lodeval::eval::eval(&a.config, &options, &Reporter::new(quiet))?;
     gate_result(&outcome)
 }

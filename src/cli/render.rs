@@ -103,7 +103,7 @@ impl RenderArgs {
             rig: self.rig,
             views,
             exr: self.exr,
-            backend: self.backend.into(),
+            backend: self.backend,
             lighting,
             cameras_json: self.cameras,
         })

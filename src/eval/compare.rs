@@ -13,8 +13,9 @@ use super::tables::{DistanceRow, MetricRow, SummaryRow};
 use crate::error::{Error, Result};
 use crate::progress::Progress;
 
-/// A `compare` request.
+/// A `compare` request: [`CompareJob::new`] with the two meshes, then set what differs.
 #[derive(Debug, Clone)]
+#[non_exhaustive]
 pub struct CompareJob {
     /// The original mesh.
     pub original: PathBuf,
@@ -30,6 +31,22 @@ pub struct CompareJob {
     pub backend: crate::backend::Backend,
     /// Shading, lighting and display.
     pub look: super::config::Look,
+}
+
+impl CompareJob {
+    /// `lod` against `original` as `lodeval compare` does by default: 20 views, 512² frames,
+    /// distances searched, the CPU reference, the default look.
+    pub fn new(original: PathBuf, lod: PathBuf) -> CompareJob {
+        CompareJob {
+            original,
+            lod,
+            views: 20,
+            size: 512,
+            distances: true,
+            backend: crate::backend::Backend::Cpu,
+            look: super::config::Look::default(),
+        }
+    }
 }
 
 /// What `compare` found.

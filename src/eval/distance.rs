@@ -103,11 +103,29 @@ impl Screen {
     }
 }
 
+impl<'a> DistanceJob<'a> {
+    /// `lod` against `original` from `directions`: one metre per model unit, no simplifier
+    /// error, unnamed rows, no switch distance, the original's probes rendered afresh.
+    pub fn new(original: &'a RenderScene, lod: &'a RenderScene, directions: Vec<Vec3>) -> Self {
+        DistanceJob {
+            original,
+            lod,
+            directions,
+            meters_per_unit: 1.0,
+            simplifier_error: None,
+            names: ("", "", 0),
+            switch_m: None,
+            originals: None,
+        }
+    }
+}
+
 /// Smallest on-screen diameter probed, pixels.
 pub(super) const MIN_PROBE: u32 = 4;
 
-/// What a search needs about one LOD.
+/// What a search needs about one LOD: [`DistanceJob::new`], then set what is known.
 #[derive(Debug)]
+#[non_exhaustive]
 pub struct DistanceJob<'a> {
     /// The original.
     pub original: &'a RenderScene,

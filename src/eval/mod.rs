@@ -19,21 +19,30 @@
 //! run also writes `shard.json` (the config text, the shard and its cases) so a merge needs
 //! nothing but the folders.
 
+#[doc(hidden)] // a stage of `eval::run`, public for tests; start from `Plan` and `run`
 pub mod assets;
+#[doc(hidden)] // a stage of `eval::run`, public for tests; start from `Plan` and `run`
 pub mod cache;
 pub mod compare;
 pub mod config;
 pub mod distance;
+#[doc(hidden)] // a stage of `eval::run`, public for tests; start from `Plan` and `run`
 pub mod export;
 pub mod gate;
 pub mod golden;
+#[doc(hidden)] // a stage of `eval::run`, public for tests; start from `Plan` and `run`
 pub mod junit;
 mod manifest;
+#[doc(hidden)] // a stage of `eval::run`, public for tests; start from `Plan` and `run`
 pub mod out;
 pub mod plan;
+#[doc(hidden)] // a stage of `eval::run`, public for tests; start from `Plan` and `run`
 pub mod plots;
+#[doc(hidden)] // a stage of `eval::run`, public for tests; start from `Plan` and `run`
 pub mod report;
+#[doc(hidden)] // a stage of `eval::run`, public for tests; start from `Plan` and `run`
 pub mod run;
+#[doc(hidden)] // a stage of `eval::run`, public for tests; start from `Plan` and `run`
 pub mod score;
 pub mod tables;
 

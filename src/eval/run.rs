@@ -34,8 +34,9 @@ use crate::metric::{LinearImage, Metric, colormap};
 use crate::progress::Progress;
 use crate::raster::{self, RenderScene};
 
-/// How to run.
+/// How to run. Start from [`RunOptions::DEFAULT`] and set what differs.
 #[derive(Debug, Clone)]
+#[non_exhaustive]
 pub struct RunOptions {
     /// Output folder override (else the config's).
     pub out: Option<PathBuf>,
@@ -45,6 +46,22 @@ pub struct RunOptions {
     pub backend: crate::backend::Backend,
     /// A render cache for the originals' frames (`--cache`; none by default).
     pub cache: Option<PathBuf>,
+}
+
+impl RunOptions {
+    /// The config's output folder, the whole run, the CPU reference, no render cache.
+    pub const DEFAULT: RunOptions = RunOptions {
+        out: None,
+        shard: Shard::ALL,
+        backend: crate::backend::Backend::Cpu,
+        cache: None,
+    };
+}
+
+impl Default for RunOptions {
+    fn default() -> Self {
+        RunOptions::DEFAULT
+    }
 }
 
 /// A finished (sharded) run.

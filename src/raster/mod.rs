@@ -33,6 +33,7 @@ mod edge;
 mod fixed;
 mod frame;
 pub mod ibl;
+#[doc(hidden)] // Williams et al.'s per-frame renderer, public for tests and benches
 pub mod incremental;
 mod pbr;
 

@@ -456,16 +456,8 @@ fn half_the_triangles_of_a_dense_scan_is_invisible_at_a_hundred_and_fifty_pixels
         RenderScene::of(Arc::new(mesh)),
         RenderScene::of(Arc::new(lod)),
     );
-    let job = DistanceJob {
-        original: &original,
-        lod: &lod,
-        directions,
-        meters_per_unit: 1.0,
-        simplifier_error: None,
-        names: ("bunny", "meshopt-r50", 0),
-        switch_m: None,
-        originals: None,
-    };
+    let mut job = DistanceJob::new(&original, &lod, directions);
+    job.names = ("bunny", "meshopt-r50", 0);
     let config = DistanceConfig {
         flip_mean: None,
         ..DistanceConfig::default()

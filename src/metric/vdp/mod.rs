@@ -39,20 +39,26 @@
 //! Here the sum is over visual angle and its scale is the observers'.
 
 mod adaptation;
+#[doc(hidden)] // the calibration against human data behind `lodeval calibrate`; public for tests
 pub mod agreement;
 pub(crate) mod bands;
+#[doc(hidden)] // the calibration against human data behind `lodeval calibrate`; public for tests
 pub mod castle;
 mod display;
 mod filter;
 pub mod fitted;
+#[doc(hidden)] // the calibration against human data behind `lodeval calibrate`; public for tests
 pub mod foley;
 pub(crate) mod masking;
+#[doc(hidden)] // the calibration against human data behind `lodeval calibrate`; public for tests
 pub mod modelfest;
 mod padding;
 mod pooling;
 mod psychometric;
+#[doc(hidden)] // the calibration against human data behind `lodeval calibrate`; public for tests
 pub mod stimuli;
 mod table;
+#[doc(hidden)] // the calibration against human data behind `lodeval calibrate`; public for tests
 pub mod threshold;
 
 use std::sync::{Arc, Mutex};

@@ -21,8 +21,11 @@
 
 mod edit;
 mod moves;
+#[doc(hidden)] // a step of the paper, public for tests and benches; start from `optimize`
 pub mod oracle;
+#[doc(hidden)] // a step of the paper, public for tests and benches; start from `optimize`
 pub mod simplex;
+#[doc(hidden)] // a step of the paper, public for tests and benches; start from `optimize`
 pub mod stats;
 
 use std::sync::Arc;
@@ -67,17 +70,22 @@ pub struct Options {
     pub log_every: u64,
 }
 
+impl Options {
+    /// The defaults each field names.
+    pub const DEFAULT: Options = Options {
+        views: 20,
+        size: 256,
+        evals: 20_000,
+        seed: 1,
+        normals: Normals::Derived,
+        attributes: true,
+        log_every: 1000,
+    };
+}
+
 impl Default for Options {
     fn default() -> Self {
-        Options {
-            views: 20,
-            size: 256,
-            evals: 20_000,
-            seed: 1,
-            normals: Normals::Derived,
-            attributes: true,
-            log_every: 1000,
-        }
+        Options::DEFAULT
     }
 }
 

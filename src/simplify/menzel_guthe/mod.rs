@@ -32,18 +32,31 @@
 //! them into metres at this API. `--error E` follows the paper's §6 scaling: an error of E times
 //! the bounding-box diagonal is at the limit when it subtends 1/30 of a degree.
 
+#[doc(hidden)] // a step of the paper, public for tests and benches; start from `simplify`
 pub mod curvature;
+#[doc(hidden)] // a step of the paper, public for tests and benches; start from `simplify`
 pub mod distance;
+#[doc(hidden)] // a step of the paper, public for tests and benches; start from `simplify`
 pub mod field;
+#[doc(hidden)] // a step of the paper, public for tests and benches; start from `simplify`
 pub mod global;
+#[doc(hidden)] // a step of the paper, public for tests and benches; start from `simplify`
 pub mod hausdorff;
+#[doc(hidden)] // a step of the paper, public for tests and benches; start from `simplify`
 pub mod masking;
+#[doc(hidden)] // a step of the paper, public for tests and benches; start from `simplify`
 pub mod perception;
+#[doc(hidden)] // a step of the paper, public for tests and benches; start from `simplify`
 pub mod pipeline;
+#[doc(hidden)] // a step of the paper, public for tests and benches; start from `simplify`
 pub mod proposal;
+#[doc(hidden)] // a step of the paper, public for tests and benches; start from `simplify`
 pub mod response;
+#[doc(hidden)] // a step of the paper, public for tests and benches; start from `simplify`
 pub mod rotation;
+#[doc(hidden)] // a step of the paper, public for tests and benches; start from `simplify`
 pub mod spectrum;
+#[doc(hidden)] // a step of the paper, public for tests and benches; start from `simplify`
 pub mod surface;
 
 use glam::Vec3;

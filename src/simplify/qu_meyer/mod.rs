@@ -27,12 +27,19 @@
 //! them; with ρ itself (the paper's literal Equation 1) a region twice as dense would get only
 //! √2 times the vertices.
 
+#[doc(hidden)] // a step of the paper, public for tests and benches; start from `remesh`
 pub mod charts;
+#[doc(hidden)] // a step of the paper, public for tests and benches; start from `remesh`
 pub mod density;
+#[doc(hidden)] // a step of the paper, public for tests and benches; start from `remesh`
 pub mod lloyd;
+#[doc(hidden)] // a step of the paper, public for tests and benches; start from `remesh`
 pub mod maps;
+#[doc(hidden)] // a step of the paper, public for tests and benches; start from `remesh`
 pub mod masking;
+#[doc(hidden)] // a step of the paper, public for tests and benches; start from `remesh`
 pub mod sampling;
+#[doc(hidden)] // a step of the paper, public for tests and benches; start from `remesh`
 pub mod triangulate;
 
 use std::sync::Arc;

@@ -15,11 +15,17 @@
 //! This file ties them together: build once ([`Williams::build`]), then adapt a cut per camera
 //! ([`Williams::adapt`]), or make a static LOD for a set of views ([`Williams::static_lod`]).
 
+#[doc(hidden)] // a step of the paper, public for tests and benches; the types are re-exported here
 pub mod bounds;
+#[doc(hidden)] // a step of the paper, public for tests and benches; the types are re-exported here
 pub mod cut;
+#[doc(hidden)] // a step of the paper, public for tests and benches; the types are re-exported here
 pub mod hierarchy;
+#[doc(hidden)] // a step of the paper, public for tests and benches; the types are re-exported here
 pub mod perception;
+#[doc(hidden)] // a step of the paper, public for tests and benches; the types are re-exported here
 pub mod preprocess;
+#[doc(hidden)] // a step of the paper, public for tests and benches; the types are re-exported here
 pub mod texels;
 
 use std::sync::Arc;
@@ -29,6 +35,8 @@ pub use hierarchy::Hierarchy;
 pub use perception::{Criterion, ViewModel, Visibility};
 pub use preprocess::Preprocessed;
 
+use std::borrow::Cow;
+
 use crate::error::Result;
 use crate::mesh::Mesh;
 use crate::raster::Shading;
@@ -36,6 +44,7 @@ use crate::scene::{Camera, Light, Scene, Viewing};
 
 /// How the views are seen and what is minimised.
 #[derive(Debug, Clone)]
+#[non_exhaustive]
 pub struct Options {
     /// The shading the LOD will be rendered with (decides the lighting contrast and the feature
     /// size). Default value: `Gouraud`.
@@ -47,21 +56,26 @@ pub struct Options {
     /// Image width and height in pixels. Default value: 512 × 512.
     pub size: (u32, u32),
     /// Lights. Default value: the scene default (one headlight).
-    pub lights: Vec<Light>,
+    pub lights: Cow<'static, [Light]>,
     /// Ambient term. Default value: the scene default, 0.15.
     pub ambient: f32,
 }
 
+impl Options {
+    /// The defaults each field names.
+    pub const DEFAULT: Options = Options {
+        shading: Shading::Gouraud,
+        criterion: Criterion::Perceptual,
+        viewing: Viewing::DEFAULT,
+        size: (512, 512),
+        lights: Cow::Borrowed(&[Light::HEADLIGHT]),
+        ambient: Scene::DEFAULT_AMBIENT,
+    };
+}
+
 impl Default for Options {
     fn default() -> Self {
-        Options {
-            shading: Shading::Gouraud,
-            criterion: Criterion::Perceptual,
-            viewing: Viewing::DEFAULT,
-            size: (512, 512),
-            lights: vec![Light::HEADLIGHT],
-            ambient: Scene::DEFAULT_AMBIENT,
-        }
+        Options::DEFAULT
     }
 }
 
