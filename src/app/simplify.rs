@@ -138,7 +138,7 @@ pub fn simplify(
             ..crate::simplify::menzel_guthe::Options::DEFAULT
         };
         let goals = crate::simplify::menzel_guthe_goals(mesh.triangle_count(), &job.goals);
-        crate::simplify::check_goals(mesh.triangle_count(), &job.goals).and_then(|()| {
+        crate::simplify::check_goals(job.method, mesh.triangle_count(), &job.goals).and_then(|()| {
             let s = crate::simplify::menzel_guthe::simplify(&mesh, &goals, &options)?;
             let counts = s.counts;
             Ok(s.lods

@@ -145,36 +145,21 @@ pub(crate) fn run(a: SimplifyArgs, quiet: bool) -> Result<(), Error> {
     }
     use lodeval::simplify::Goal;
     let method = a.method;
-    let unit = |r: f64, what: &str| {
-        if r > 0.0 && r <= 1.0 {
-            Ok(r)
-        } else {
-            Err(Error::Usage(format!("{what} {r}: use a value in (0, 1]")))
-        }
-    };
     if method != Method::MenzelGuthe && a.distance.is_some() {
         return Err(Error::Usage(
             "--distance is for --method williams or menzel-guthe".into(),
         ));
     }
-    let goals: Vec<Goal> = if let Some(d) = a.distance {
-        vec![Goal::Distance(d)]
+    let (flag, goals): (&str, Vec<Goal>) = if let Some(d) = a.distance {
+        ("--distance", vec![Goal::Distance(d)])
     } else if !a.chain.is_empty() {
-        a.chain
-            .iter()
-            .map(|&r| unit(r, "--chain").map(Goal::Ratio))
-            .collect::<Result<_, _>>()?
+        ("--chain", a.chain.iter().map(|&r| Goal::Ratio(r)).collect())
     } else if let Some(r) = a.ratio {
-        vec![Goal::Ratio(unit(r, "--ratio")?)]
+        ("--ratio", vec![Goal::Ratio(r)])
     } else if let Some(t) = a.triangles {
-        vec![Goal::Triangles(t.max(1))]
+        ("--triangles", vec![Goal::Triangles(t.max(1))])
     } else if let Some(e) = a.error {
-        if method == Method::MenzelGuthe && !(e > 0.0 && e < 1.0) {
-            return Err(Error::Usage(format!(
-                "--error {e}: give a fraction of the bounding-box diagonal in (0, 1)"
-            )));
-        }
-        vec![Goal::Error(unit(e, "--error")?)]
+        ("--error", vec![Goal::Error(e)])
     } else {
         return Err(Error::Usage(
             "give --ratio R, --triangles N, --error E, --chain R1,R2,... or (menzel-guthe) \
@@ -182,6 +167,10 @@ pub(crate) fn run(a: SimplifyArgs, quiet: bool) -> Result<(), Error> {
                 .into(),
         ));
     };
+    // The library's checks, before the mesh is read; the mesh's triangle count is checked
+    // once it is.
+    lodeval::simplify::goals::check(method, &goals, None)
+        .map_err(|why| Error::Usage(format!("{flag}: {why}")))?;
     let job = lodeval::app::SimplifyJob {
         mesh: a.mesh.expect("clap requires it"),
         out: a.out.expect("clap requires it"),

@@ -7,11 +7,13 @@
 
 use std::path::{Path, PathBuf};
 
-use super::plan::{Plan, Shard};
+use super::config::{AssetConfig, Config, HeatmapChoice, ImageSize, LodConfig, RigName};
+use super::plan::Plan;
 use super::run::{RunOptions, evaluate};
 use super::tables::{DistanceRow, MetricRow, SummaryRow};
 use crate::error::{Error, Result};
 use crate::progress::Progress;
+use crate::scene::Rig;
 
 /// A `compare` request: [`CompareJob::new`] with the two meshes, then set what differs.
 #[derive(Debug, Clone)]
@@ -73,66 +75,76 @@ pub fn rig_for(views: u32) -> String {
     }
 }
 
-/// A file's stem as an asset or LOD name.
+/// A file's stem as an asset or LOD name: characters a name cannot hold (see
+/// `config::Name`) become `_`, so that any file can be compared.
 fn stem(p: &Path) -> String {
-    p.file_stem()
+    let stem: String = p
+        .file_stem()
         .map_or_else(|| "mesh".into(), |s| s.to_string_lossy().into_owned())
+        .chars()
+        .map(|c| {
+            if c.is_ascii_alphanumeric() || matches!(c, '-' | '_' | '.') {
+                c
+            } else {
+                '_'
+            }
+        })
+        .collect();
+    if stem.is_empty() || stem == "." || stem == ".." {
+        "mesh".into()
+    } else {
+        stem
+    }
 }
 
-/// The in-memory plan: one asset, one LOD, images off.
+/// The in-memory plan: one asset, one LOD, images off, built as a value (no TOML text, so
+/// any file name works); a message about a bad value names the argument it came from.
 fn plan(job: &CompareJob) -> Result<Plan> {
     let abs = |p: &Path| std::path::absolute(p).unwrap_or_else(|_| p.to_path_buf());
-    let text = |p: &Path| {
-        abs(p).to_str().map(str::to_string).ok_or_else(|| {
-            Error::input(
-                p,
-                "the path is not valid UTF-8",
-                "rename the file or its folder with UTF-8 characters",
-            )
-        })
-    };
+    for (what, path) in [("ORIGINAL", &job.original), ("LOD", &job.lod)] {
+        if !path.is_file() {
+            return Err(Error::input(
+                path,
+                format!("{what} is not there (or not a file)"),
+                "give the path of a mesh file (OBJ, PLY, glTF, GLB or OFF)",
+            ));
+        }
+    }
     let original = stem(&job.original);
     let mut lod = stem(&job.lod);
     if lod == original {
         lod.push_str("-lod");
     }
-    let mut asset = toml::Table::new();
-    asset.insert("name".into(), original.into());
-    asset.insert("mesh".into(), text(&job.original)?.into());
-    let mut l = toml::Table::new();
-    l.insert("mesh".into(), text(&job.lod)?.into());
-    l.insert("name".into(), lod.into());
-    asset.insert("lods".into(), toml::Value::Array(vec![l.into()]));
-    let mut render = toml::Table::new();
-    render.insert("size".into(), i64::from(job.size).into());
-    render.insert("rig".into(), rig_for(job.views).into());
-    job.look.insert_into(&mut render);
-    let mut images = toml::Table::new();
-    images.insert("heatmaps".into(), "none".into());
-    images.insert("contact_sheets".into(), false.into());
-    let mut distance = toml::Table::new();
-    distance.insert("enabled".into(), job.distances.into());
-    let mut config = toml::Table::new();
-    config.insert("render".into(), render.into());
-    config.insert("images".into(), images.into());
-    config.insert("distance".into(), distance.into());
-    config.insert("asset".into(), toml::Value::Array(vec![asset.into()]));
-    let text = toml::to_string(&config)
-        .map_err(|e| Error::Internal(format!("compare: the plan as TOML: {e}")))?;
-    let plan = Plan::from_text(text, Path::new("<compare>"))?;
-    plan.check_meshes()?;
-    Ok(plan)
+    let argument = |what: &str, path: &Path, why: String| {
+        Error::input(
+            path,
+            format!("{what}: {why}"),
+            "rename the file: its stem names the rows (letters, digits, '-', '_', '.')",
+        )
+    };
+    let mut asset = AssetConfig::new(&original, abs(&job.original))
+        .map_err(|why| argument("ORIGINAL", &job.original, why))?;
+    asset
+        .lods
+        .push(LodConfig::new(&lod, abs(&job.lod)).map_err(|why| argument("LOD", &job.lod, why))?);
+    let mut config = Config::new(vec![asset]);
+    config.render.size =
+        ImageSize::try_from(job.size).map_err(|why| Error::Usage(format!("--size: {why}")))?;
+    config.render.rig = RigName(Rig::parse(&rig_for(job.views)).map_err(Error::Usage)?);
+    job.look
+        .apply_to(&mut config.render)
+        .map_err(|why| Error::Usage(format!("the look: {why}")))?;
+    config.images.heatmaps = HeatmapChoice::None;
+    config.images.contact_sheets = false;
+    config.distance.enabled = job.distances;
+    Plan::from_config(config, Path::new("<compare>"))
 }
 
 /// Compare `job.lod` with `job.original`.
 pub fn compare(job: &CompareJob, progress: &dyn Progress) -> Result<CompareReport> {
     let plan = plan(job)?;
-    let options = RunOptions {
-        out: None,
-        shard: Shard::ALL,
-        backend: job.backend,
-        cache: None,
-    };
+    let mut options = RunOptions::DEFAULT;
+    options.backend = job.backend;
     let (results, warnings, _) = evaluate(&plan, &options, progress, None)?;
     let triangles = results
         .lods

@@ -98,15 +98,9 @@ pub fn measure(
     meters_per_unit: f64,
     look: &super::config::Look,
 ) -> Result<Vec<DistanceRow>> {
-    let mut render = toml::Table::new();
-    look.insert_into(&mut render);
-    let mut table = toml::Table::new();
-    table.insert("render".into(), render.into());
-    table.insert("asset".into(), toml::Value::Array(Vec::new()));
-    let text = toml::to_string(&table)
-        .map_err(|e| crate::error::Error::Internal(format!("default config: {e}")))?;
-    let mut cfg: super::config::Config = toml::from_str(&text)
-        .map_err(|e| crate::error::Error::Internal(format!("default config: {e}")))?;
+    let mut cfg = super::config::Config::new(Vec::new());
+    look.apply_to(&mut cfg.render)
+        .map_err(|why| crate::error::Error::Usage(format!("the look: {why}")))?;
     cfg.render.lighting = crate::scene::Lighting::new(
         &cfg.render.environment,
         std::path::Path::new("."),

@@ -180,6 +180,20 @@ impl Plan {
     /// Expand config text; `config_path` anchors relative paths.
     pub fn from_text(text: String, config_path: &Path) -> Result<Plan> {
         let config = Config::parse(&text, config_path)?;
+        Plan::expand(config, text, config_path)
+    }
+
+    /// A plan from a config built as a value (see [`Config::new`]): checked as a file would
+    /// be; `origin` names it in messages and anchors its relative paths. Its text (for the
+    /// run's manifest) is the config written as TOML.
+    pub fn from_config(config: Config, origin: &Path) -> Result<Plan> {
+        let config = config.checked(origin)?;
+        let text = config.to_toml()?;
+        Plan::expand(config, text, origin)
+    }
+
+    /// Assets × LODs with their layered limits, from a checked config.
+    fn expand(config: Config, text: String, config_path: &Path) -> Result<Plan> {
         let base = config_dir(config_path);
         let file = config_path.display().to_string();
         let global = layer(&config.thresholds, &format!("{file} [thresholds]"), &[]);
@@ -401,6 +415,7 @@ fn fnv1a(bytes: &[u8]) -> u64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::eval::config::{AssetConfig, LodConfig};
 
     #[test]
     fn thresholds_layer_and_remember_their_origin() {
@@ -427,6 +442,74 @@ lods = [{ mesh = "a1.obj", thresholds = { psnr_min = 30.0 } }, { mesh = "a2.obj"
         assert_eq!(get(&l[1], "psnr_min").0, 20.0);
         assert!(get(&l[1], "psnr_min").1.contains("[thresholds]"));
         assert_eq!(p.assets[0].mesh, Path::new("c/a.obj"));
+    }
+
+    #[test]
+    fn a_config_written_as_toml_reads_back_as_itself() {
+        // Every shipped config, and one with thresholds, lights and generated LODs.
+        let mut texts: Vec<(String, PathBuf)> = ["demo.toml", "ci.toml", "nightly.toml"]
+            .iter()
+            .map(|f| {
+                let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+                    .join("configs")
+                    .join(f);
+                (std::fs::read_to_string(&path).unwrap(), path)
+            })
+            .collect();
+        texts.push((
+            r#"
+metrics = ["flip", "psnr", "vdp"]
+[thresholds]
+flip_mean = 0.1
+[render]
+rig = "fibonacci:7"
+tone_mapping = "aces"
+lights = [{ kind = "directional", direction = [0.0, 1.0, 0.0], intensity = 0.5 }]
+[[asset]]
+name = "a"
+mesh = "a.obj"
+generate = { method = "meshopt", ratios = [0.5, 0.25], switch_m = [3.0, 6.0] }
+lods = [{ mesh = "a1.obj", name = "x", thresholds = { psnr_min = 30.0 } }]
+"#
+            .into(),
+            PathBuf::from("c/x.toml"),
+        ));
+        for (text, path) in texts {
+            let config = Config::parse(&text, &path).unwrap();
+            let written = config.to_toml().unwrap();
+            let again = Config::parse(&written, &path).unwrap();
+            assert_eq!(again.to_toml().unwrap(), written, "{}", path.display());
+            let (a, b) = (
+                Plan::from_text(text, &path).unwrap(),
+                Plan::from_config(again, &path).unwrap(),
+            );
+            assert_eq!(a.case_ids(), b.case_ids());
+            for (x, y) in a.assets.iter().zip(&b.assets) {
+                assert_eq!((&x.mesh, x.meters_per_unit), (&y.mesh, y.meters_per_unit));
+                for (l, m) in x.lods.iter().zip(&y.lods) {
+                    assert_eq!(format!("{:?}", l.limits), format!("{:?}", m.limits));
+                    assert_eq!(l.switch_m, m.switch_m);
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn a_plan_built_as_a_value_takes_any_file_name_and_is_checked() {
+        let weird = PathBuf::from(r#"C:\models\a "quoted" name.obj"#);
+        let mut asset = AssetConfig::new("a", weird.clone()).unwrap();
+        asset
+            .lods
+            .push(LodConfig::new("a-lod", weird.clone()).unwrap());
+        let plan = Plan::from_config(Config::new(vec![asset]), Path::new("<test>")).unwrap();
+        assert_eq!(plan.assets[0].mesh, weird);
+        assert!(AssetConfig::new("a/b", weird.clone()).is_err());
+        let mut bad = Config::new(vec![AssetConfig::new("a", weird).unwrap()]);
+        bad.metrics.clear();
+        let e = Plan::from_config(bad, Path::new("<test>"))
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("metrics is empty"), "{e}");
     }
 
     #[test]

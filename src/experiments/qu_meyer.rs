@@ -18,8 +18,11 @@ use std::sync::Arc;
 use serde::{Deserialize, Serialize};
 
 use crate::error::{Error, Result};
+use crate::eval::config::{
+    AssetConfig, Config, HeatmapChoice, ImageSize, LodConfig, RigName, SampleCount, ShadingName,
+};
 use crate::mesh::{self, LoadOptions};
-use crate::metric::Metric;
+use crate::metric::{Metric, MetricFamily};
 use crate::simplify::qu_meyer::{self, Method, Options};
 
 /// One model of the experiment.
@@ -155,11 +158,18 @@ pub fn run(config: &Path, log: &mut dyn FnMut(&str)) -> Result<Report> {
         seconds: f64,
     }
     let mut made: Vec<Made> = Vec::new();
-    let mut assets = String::new();
+    let mut assets: Vec<AssetConfig> = Vec::new();
+    let named = |e: String| {
+        Error::input(
+            config,
+            e,
+            "model names and budgets name files and rows: letters, digits, '-', '_', '.'",
+        )
+    };
     for m in &exp.model {
         let path = crate::io::resolve(&base, &m.mesh);
         let input = Arc::new(mesh::load(&path, &LoadOptions::default())?);
-        let mut lods = Vec::new();
+        let mut asset = AssetConfig::new(&m.name, relative(&path, &out)).map_err(named)?;
         for (k, &budget) in m.vertices.iter().enumerate() {
             // (label, method, TVI weight)
             let mut variants: Vec<(&str, Method, f64)> = vec![
@@ -196,10 +206,9 @@ pub fn run(config: &Path, log: &mut dyn FnMut(&str)) -> Result<Report> {
                     100.0 * r.masked_share,
                     seconds
                 ));
-                lods.push(format!(
-                    "  {{ mesh = \"{}\", name = \"{name}\" }},\n",
-                    relative(&file, &out).display()
-                ));
+                asset
+                    .lods
+                    .push(LodConfig::new(&name, relative(&file, &out)).map_err(named)?);
                 made.push(Made {
                     model: m.name.clone(),
                     budget,
@@ -211,33 +220,20 @@ pub fn run(config: &Path, log: &mut dyn FnMut(&str)) -> Result<Report> {
                 });
             }
         }
-        assets.push_str(&format!(
-            "\n[[asset]]\nname = \"{}\"\nmesh = \"{}\"\nlods = [\n{}]\n",
-            m.name,
-            relative(&path, &out).display(),
-            lods.concat()
-        ));
+        assets.push(asset);
     }
     // Score every remesh with eval, from a config written beside the results.
     let eval_config = out.join("eval.toml");
     let text = format!(
         "# Written by `lodeval remesh --experiment` (Qu & Meyer): every remesh scored against its\n\
-         # original over the 20 dodecahedron views. Rerun with `lodeval eval` on this file.\n\
-         out = \"eval\"\nmetrics = [\"flip\", \"vdp\"]\n\n[render]\nsize = {}\nsamples = 4\n\
-         rig = \"dodecahedron\"\nshading = \"phong\"\n\n[distance]\nenabled = false\n\n[images]\n\
-         heatmaps = \"none\"\ncontact_sheets = true\n{assets}",
-        exp.size
+         # original over the 20 dodecahedron views. Rerun with `lodeval eval` on this file.\n{}",
+        scoring_config(assets, exp.size)?.to_toml()?
     );
     crate::io::write_atomic(&eval_config, text.as_bytes())?;
     log("scoring every remesh with eval (FLIP and the VDP, 20 views)");
     let outcome = crate::eval::eval(
         &eval_config,
-        &crate::eval::RunOptions {
-            out: None,
-            shard: crate::eval::Shard::ALL,
-            backend: crate::backend::Backend::Cpu,
-            cache: None,
-        },
+        &crate::eval::RunOptions::DEFAULT,
         &crate::progress::Silent,
     )?;
     let mean = |a: &str, l: &str, metric: Metric| outcome.results.mean(a, l, metric).unwrap_or(0.0);
@@ -265,4 +261,20 @@ pub fn run(config: &Path, log: &mut dyn FnMut(&str)) -> Result<Report> {
         .collect();
     crate::io::csv::write_rows(&out.join("results.csv"), None, &rows)?;
     Ok(Report { out, rows })
+}
+
+/// The `eval` config that scores every remesh: FLIP and the VDP over the 20 dodecahedron views,
+/// Phong shading, no distances, contact sheets, into `eval/` beside it.
+fn scoring_config(assets: Vec<AssetConfig>, size: u32) -> Result<Config> {
+    let mut c = Config::new(assets);
+    c.out = Some("eval".into());
+    c.metrics = vec![MetricFamily::Flip, MetricFamily::Vdp];
+    c.render.size = ImageSize::try_from(size).map_err(Error::Usage)?;
+    c.render.samples = SampleCount(4);
+    c.render.rig = RigName(crate::scene::Rig::Dodecahedron);
+    c.render.shading = ShadingName(crate::raster::Shading::Phong);
+    c.distance.enabled = false;
+    c.images.heatmaps = HeatmapChoice::None;
+    c.images.contact_sheets = true;
+    Ok(c)
 }

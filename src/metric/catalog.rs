@@ -9,7 +9,7 @@
 use serde::{Deserialize, Serialize};
 
 /// Metric families: what a config's `metrics` list names; each writes one or more [`Metric`]s.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum MetricFamily {
     /// `flip` (mean), `flip_p95`, `flip_share`.

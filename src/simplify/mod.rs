@@ -6,6 +6,7 @@
 
 pub mod attributes;
 pub mod cluster;
+pub mod goals;
 pub mod lindstrom_turk;
 pub mod menzel_guthe;
 pub mod meshopt;
@@ -214,24 +215,9 @@ pub fn chain_scaled(
     goals: &[Goal],
     meters_per_unit: f64,
 ) -> Result<Vec<Lod>> {
-    check_goals(mesh.triangle_count(), goals)?;
-    let vertex_goal = goals.iter().find(|g| matches!(g, Goal::Vertices(_)));
+    check_goals(method, mesh.triangle_count(), goals)?;
     if method == Method::QuMeyer {
         return qu_meyer_chain(mesh, goals);
-    } else if let Some(g) = vertex_goal {
-        return Err(Error::Usage(format!(
-            "{} takes ratio, triangle or error goals, not {g}; a vertex goal is for qu-meyer",
-            method.name()
-        )));
-    }
-    if method != Method::MenzelGuthe
-        && let Some(d) = goals.iter().find(|g| matches!(g, Goal::Distance(_)))
-    {
-        return Err(Error::Usage(format!(
-            "{} takes ratio, triangle or error goals, not a {d}; a distance goal is for \
-             menzel-guthe",
-            method.name()
-        )));
     }
     if method == Method::MenzelGuthe {
         // Its own weld and attributes: the simplifier keeps seams and flat shading as they are.
@@ -252,53 +238,10 @@ pub fn chain_scaled(
     chain_of(mesh, method, goals)
 }
 
-/// The checks of [`chain`]'s goals against a mesh of `triangles` triangles.
-pub fn check_goals(triangles: usize, goals: &[Goal]) -> Result<()> {
-    for g in goals {
-        match *g {
-            Goal::Distance(d) if !(d.is_finite() && d > 0.0) => {
-                return Err(Error::Usage(format!(
-                    "distance {d}: give a viewing distance in metres above 0"
-                )));
-            }
-            Goal::Ratio(r) | Goal::Error(r) if !(r.is_finite() && r > 0.0 && r <= 1.0) => {
-                return Err(Error::Usage(format!(
-                    "goal {r} is outside (0, 1]: ratios and relative errors are fractions"
-                )));
-            }
-            Goal::Triangles(t) if t == 0 || t > triangles => {
-                return Err(Error::Usage(format!(
-                    "a goal of {t} triangles is outside 1..={triangles} (the mesh has {triangles}): \
-                     give a smaller count, or --ratio"
-                )));
-            }
-            Goal::Vertices(v) => {
-                crate::limits::REMESH_VERTICES
-                    .check("vertices", v as u64)
-                    .map_err(Error::Usage)?;
-            }
-            _ => {}
-        }
-    }
-    for pair in goals.windows(2) {
-        let coarser = match (pair[0], pair[1]) {
-            (Goal::Ratio(a), Goal::Ratio(b)) => b < a,
-            (Goal::Triangles(a), Goal::Triangles(b)) => b < a,
-            (Goal::Error(a), Goal::Error(b)) => b > a,
-            (Goal::Distance(a), Goal::Distance(b)) => b > a,
-            (Goal::Vertices(a), Goal::Vertices(b)) => b < a,
-            _ => true,
-        };
-        if !coarser {
-            return Err(Error::Usage(format!(
-                "the chain's goals {} then {} do not get coarser: each LOD of a chain must be \
-                 simpler than the one before; order ratios from the largest to the smallest \
-                 (e.g. 0.5,0.25)",
-                pair[0], pair[1]
-            )));
-        }
-    }
-    Ok(())
+/// The checks of [`chain`]'s goals for `method` against a mesh of `triangles` triangles (see
+/// `goals.rs`), as a usage error.
+pub fn check_goals(method: Method, triangles: usize, goals: &[Goal]) -> Result<()> {
+    goals::check(method, goals, Some(triangles)).map_err(Error::Usage)
 }
 
 /// `goals` for a mesh of `triangles` triangles in Menzel & Guthe's terms (ratios become

@@ -304,9 +304,31 @@ fn compare_scores_what_eval_scores_for_the_same_views() {
         "{}",
         r.stdout
     );
-    // A missing mesh is an input error.
+    // A missing mesh is an input error naming the argument, not a config nobody wrote.
     let r = lodeval(["compare", original.to_str().unwrap(), "/nonexistent/x.obj"]);
     assert_eq!(r.code, 2, "{}", r.stderr);
+    assert!(
+        r.stderr.contains("/nonexistent/x.obj")
+            && r.stderr.contains("LOD is not there")
+            && !r.stderr.contains("<compare>"),
+        "{}",
+        r.stderr
+    );
+    // Any file name works: the plan is built as a value, not as TOML text.
+    let odd = dir.path().join("a \"quoted\" name.obj");
+    std::fs::copy(&lod, &odd).unwrap();
+    let r = lodeval([
+        "compare",
+        original.to_str().unwrap(),
+        odd.to_str().unwrap(),
+        "--views",
+        "1",
+        "--size",
+        "32",
+        "--no-distances",
+    ]);
+    assert_eq!(r.code, 0, "{}", r.stderr);
+    assert!(r.stdout.contains("view"), "{}", r.stdout);
 }
 
 #[test]

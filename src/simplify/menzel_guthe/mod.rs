@@ -155,30 +155,19 @@ pub struct Simplified {
     pub setup_seconds: f64,
 }
 
-/// Check `goals` (exit 2 on nonsense): distances finite and above 0, errors in (0, 1),
-/// triangle counts within the mesh's.
+/// Check `goals` (exit 2 on nonsense), as every simplifier's goals are (`simplify/goals.rs`):
+/// distances finite and above 0, errors in (0, 1), triangle counts within the mesh's, a chain
+/// that gets coarser.
 pub fn check_goals(triangles: usize, goals: &[Goal]) -> Result<()> {
-    for g in goals {
-        match *g {
-            Goal::Distance(d) if !(d.is_finite() && d > 0.0) => {
-                return Err(Error::Usage(format!(
-                    "--distance {d}: give a viewing distance in metres above 0"
-                )));
-            }
-            Goal::Error(e) if !(e.is_finite() && e > 0.0 && e < 1.0) => {
-                return Err(Error::Usage(format!(
-                    "--error {e}: give a fraction of the bounding-box diagonal in (0, 1)"
-                )));
-            }
-            Goal::Triangles(t) if t == 0 || t > triangles => {
-                return Err(Error::Usage(format!(
-                    "a goal of {t} triangles is outside 1..={triangles} (the mesh has {triangles})"
-                )));
-            }
-            _ => {}
-        }
-    }
-    Ok(())
+    let goals: Vec<super::Goal> = goals
+        .iter()
+        .map(|&g| match g {
+            Goal::Triangles(t) => super::Goal::Triangles(t),
+            Goal::Error(e) => super::Goal::Error(e),
+            Goal::Distance(d) => super::Goal::Distance(d),
+        })
+        .collect();
+    super::goals::check(super::Method::MenzelGuthe, &goals, Some(triangles)).map_err(Error::Usage)
 }
 
 /// Simplify `mesh` to every goal in one progressive run (to the coarsest).

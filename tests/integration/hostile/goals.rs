@@ -53,9 +53,9 @@ fn a_config_chain_that_does_not_get_coarser_names_the_file_and_line() {
     let d = tmp.path();
     let mesh = model("spot/spot_mtl.obj");
     for (generate, seen) in [
-        ("ratios = [0.25, 0.5]", "0.25 then 0.5"),
-        ("ratios = [0.501, 0.502]", "0.501 then 0.502"),
-        ("errors = [0.05, 0.01]", "0.05 then 0.01"),
+        ("ratios = [0.25, 0.5]", "ratio 0.25 then ratio 0.5"),
+        ("ratios = [0.501, 0.502]", "ratio 0.501 then ratio 0.502"),
+        ("errors = [0.05, 0.01]", "error 0.05 then error 0.01"),
     ] {
         let config = write(
             d,
