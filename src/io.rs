@@ -10,6 +10,7 @@ pub mod finite;
 pub mod label;
 pub mod plot;
 pub mod plot_png;
+pub mod sheet;
 pub mod staged;
 
 pub use staged::{Staged, disown, forget, interrupted, own, remove_on_interrupt, written_under};

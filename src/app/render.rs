@@ -6,7 +6,7 @@ use std::sync::Arc;
 
 use crate::error::{Error, Result};
 use crate::mesh::{self, LoadOptions};
-use crate::raster::{self, Frame, RenderScene, RenderSettings};
+use crate::raster::{Frame, RenderScene, RenderSettings};
 use crate::scene::Rig;
 
 /// Which views `lodeval render` writes.
@@ -167,12 +167,12 @@ pub fn render(job: &RenderJob) -> Result<RenderReport> {
         ViewSelection::Sheet { out } => {
             let (n, side) = (cameras.len() as u64, job.settings.width as u64);
             let columns = (n as f64).sqrt().ceil() as u64;
-            raster::check_sheet(n, columns, (side, job.settings.height as u64), 4)?;
+            crate::io::sheet::check_sheet(n, columns, (side, job.settings.height as u64), 4)?;
             let frames = cameras
                 .iter()
                 .map(|c| renderer.render(c, &job.settings).map(|f| f.to_srgb8()))
                 .collect::<Result<Vec<_>>>()?;
-            let sheet = raster::contact_sheet(&frames, columns as u32, 4, [32, 32, 32])?;
+            let sheet = crate::io::sheet::contact_sheet(&frames, columns as u32, 4, [32, 32, 32])?;
             crate::io::write_image(out, &image::DynamicImage::ImageRgb8(sheet))?;
             written.push(out.clone());
         }

@@ -1070,7 +1070,7 @@ impl Config {
         if self.images.contact_sheets {
             let views = self.render.rig.0.count().min(self.images.sheet_views) as u64;
             let side = self.render.size.0 as u64;
-            crate::raster::check_sheet(3 * views, 3, (side, side), 4).map_err(|e| {
+            crate::io::sheet::check_sheet(3 * views, 3, (side, side), 4).map_err(|e| {
                 fail(
                     "images.sheet_views",
                     format!("[images] {e}"),

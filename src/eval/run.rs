@@ -345,7 +345,7 @@ fn write_sheets(
                     tiles.extend(t.iter().cloned());
                 }
             }
-            let sheet = raster::contact_sheet(&tiles, 3, 4, [32, 32, 32])?;
+            let sheet = crate::io::sheet::contact_sheet(&tiles, 3, 4, [32, 32, 32])?;
             crate::io::write_image(
                 &out_dir
                     .join("sheets")

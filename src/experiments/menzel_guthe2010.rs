@@ -509,7 +509,7 @@ fn figure1(
     }
     crate::io::csv::write_rows(&out.join("figure1.csv"), None, &rows)?;
     // Two columns (original | LOD), one row per material.
-    let sheet = raster::contact_sheet(&tiles, 2, 4, [255; 3])?;
+    let sheet = crate::io::sheet::contact_sheet(&tiles, 2, 4, [255; 3])?;
     crate::io::write_image(
         &out.join("figure1-sheet.png"),
         &image::DynamicImage::ImageRgb8(sheet),

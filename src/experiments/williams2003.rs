@@ -375,7 +375,7 @@ pub fn run(config: &Path, log: &mut dyn FnMut(&str)) -> Result<Vec<SummaryRow>> 
                 }
             })
             .collect();
-        let sheet = raster::contact_sheet(&images, images.len() as u32, 4, [255; 3])?;
+        let sheet = crate::io::sheet::contact_sheet(&images, images.len() as u32, 4, [255; 3])?;
         crate::io::write_image(
             &out.join(format!("{}-sheet.png", spec.name)),
             &image::DynamicImage::ImageRgb8(sheet),

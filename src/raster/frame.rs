@@ -3,8 +3,6 @@
 
 use glam::Vec3;
 
-use crate::error::{Error, Result};
-
 /// Triangle id of a pixel no triangle covers.
 pub const NO_TRIANGLE: u32 = u32::MAX;
 
@@ -62,6 +60,21 @@ impl Frame {
         &self.triangle
     }
 
+    /// A `width`×`height` frame on recycled channel buffers (`recycle.rs`): their contents are
+    /// a fill value or an earlier frame's pixels, so every pixel must be written before it is
+    /// read (the tiles of a render each write all of theirs).
+    pub(super) fn recycled(width: u32, height: u32) -> Frame {
+        let n = width as usize * height as usize;
+        Frame {
+            width,
+            height,
+            color: super::recycle::take(n, Vec3::ZERO),
+            depth: super::recycle::take(n, 0.0),
+            coverage: super::recycle::take(n, 0.0),
+            triangle: super::recycle::take(n, 0),
+        }
+    }
+
     /// The colour as 8-bit sRGB, RGB order (values outside 0..1 are clipped).
     pub fn to_srgb8(&self) -> image::RgbImage {
         crate::image::srgb8_image(self.width as usize, self.height as usize, &self.color)
@@ -73,56 +86,6 @@ impl Frame {
         image::Rgb32FImage::from_raw(self.width, self.height, v)
             .expect("sizes match by construction")
     }
-}
-
-/// The pixel size (width, height) of a contact sheet of `count` tiles of `tile` pixels in a grid
-/// `columns` wide with `gap`-pixel borders, in 64 bits (no overflow for any `u32` inputs).
-pub fn sheet_dimensions(count: u64, columns: u64, tile: (u64, u64), gap: u64) -> (u64, u64) {
-    let columns = columns.max(1);
-    let rows = count.div_ceil(columns).max(1);
-    (columns * (tile.0 + gap) + gap, rows * (tile.1 + gap) + gap)
-}
-
-/// `Ok` when a contact sheet of that layout stays within [`crate::limits::SHEET_PIXELS`] (it is
-/// held in memory whole), else a usage error that names its size. Callers check before they
-/// render the tiles; [`contact_sheet`] checks again.
-pub fn check_sheet(count: u64, columns: u64, tile: (u64, u64), gap: u64) -> Result<()> {
-    let (w, h) = sheet_dimensions(count, columns, tile, gap);
-    match crate::limits::SHEET_PIXELS.refuse(w * h) {
-        None if w <= u32::MAX as u64 && h <= u32::MAX as u64 => Ok(()),
-        refusal => Err(Error::Usage(format!(
-            "a contact sheet of {count} images of {}x{} pixels would be {w}x{h} pixels: {}",
-            tile.0,
-            tile.1,
-            refusal.unwrap_or_else(|| "wider than an image can be".into())
-        ))),
-    }
-}
-
-/// Tile 8-bit images into a grid `columns` wide, in order, with a `gap`-pixel border of `bg`.
-/// All images must have the same size; the sheet must pass [`check_sheet`].
-pub fn contact_sheet(
-    images: &[image::RgbImage],
-    columns: u32,
-    gap: u32,
-    bg: [u8; 3],
-) -> Result<image::RgbImage> {
-    let columns = columns.max(1);
-    let (w, h) = images.first().map_or((1, 1), |i| i.dimensions());
-    let count = images.len() as u64;
-    check_sheet(count, columns as u64, (w as u64, h as u64), gap as u64)?;
-    let (sw, sh) = sheet_dimensions(count, columns as u64, (w as u64, h as u64), gap as u64);
-    let mut sheet = image::RgbImage::from_pixel(sw as u32, sh as u32, image::Rgb(bg));
-    for (k, img) in images.iter().enumerate() {
-        let (c, r) = (k as u32 % columns, k as u32 / columns);
-        image::imageops::replace(
-            &mut sheet,
-            img,
-            (gap + c * (w + gap)) as i64,
-            (gap + r * (h + gap)) as i64,
-        );
-    }
-    Ok(sheet)
 }
 
 impl From<&Frame> for crate::image::LinearImage {

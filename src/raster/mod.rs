@@ -7,6 +7,9 @@
 //! 3. `edge.rs` — per tile, in parallel: scan-convert its triangles into per-sample depth and
 //!    triangle-id buffers (a visibility buffer) with integer edge functions and the top-left rule;
 //!    small triangles at 4 samples per pixel in 32-bit vector lanes.
+//!
+//! `pass.rs` holds one frame's set-up state (stages 1–3 run from it); `render` below calls
+//! the stages in this order.
 //! 4. `resolve.rs` — per pixel: shade (`shade.rs`, textures from `texture.rs`) once per distinct
 //!    triangle among its samples, at that triangle's first covered sample, and average the samples in
 //!    linear light.
@@ -35,6 +38,7 @@ mod frame;
 pub mod ibl;
 #[doc(hidden)] // Williams et al.'s per-frame renderer, public for tests and benches
 pub mod incremental;
+mod pass;
 mod pbr;
 
 mod prepare;
@@ -54,7 +58,8 @@ use crate::error::{Error, Result};
 use crate::mesh::Mesh;
 use crate::scene::{Camera, Projection};
 
-pub use frame::{Frame, NO_TRIANGLE, check_sheet, contact_sheet, sheet_dimensions};
+pub use frame::{Frame, NO_TRIANGLE};
+use pass::{Pass, Visibility};
 #[cfg(feature = "gpu")]
 pub(crate) use pbr::PbrLight;
 pub use prepare::PreparedMesh;
@@ -286,11 +291,28 @@ impl Default for RenderSettings {
     }
 }
 
-/// Render `scene` from `camera`.
+/// Render `scene` from `camera`: the pipeline of the module comment, stage by stage.
 pub fn render(scene: &RenderScene, camera: &Camera, settings: &RenderSettings) -> Result<Frame> {
     settings.check()?;
-    let pass = resolve::Pass::new(scene, camera, settings, resolve::Visibility::Fastest);
-    Ok(pass.resolve_frame(&pass.context(None)))
+    // Stages 1 and 2: transform, clip and set up every triangle, and bin it into tiles (or, at
+    // one sample per pixel, scan it into the workers' key buffers there and then).
+    let pass = Pass::new(scene, camera, settings, Visibility::Fastest);
+    let shading = pass.context(None);
+    Ok(draw(&pass, &shading))
+}
+
+/// Stages 3 and 4, per tile in parallel, each straight into its pixels of a recycled frame:
+/// scan-convert the tile's triangles into samples, then resolve its samples into pixels.
+fn draw(pass: &Pass, shading: &shade::ShadeContext) -> Frame {
+    let (w, h) = (pass.settings.width, pass.settings.height);
+    let mut frame = Frame::recycled(w, h);
+    let tiles = resolve::frame_tiles(&mut frame, bin::TILE as usize);
+    debug_assert_eq!(tiles.len(), bin::tile_count(w, h));
+    tiles
+        .into_par_iter()
+        .enumerate()
+        .for_each(|(t, mut pixels)| pass.resolve(shading, &pass.raster_tile(t), &mut pixels));
+    frame
 }
 
 /// Diagnostic: for every sample, how many triangles cover it (no depth test). A closed mesh seen
@@ -303,7 +325,7 @@ pub fn coverage_counts(
     settings: &RenderSettings,
 ) -> Result<Vec<u16>> {
     settings.check()?;
-    let pass = resolve::Pass::new(scene, camera, settings, resolve::Visibility::Counts);
+    let pass = Pass::new(scene, camera, settings, Visibility::Counts);
     Ok(pass.counts())
 }
 

@@ -11,7 +11,7 @@
 //! the same way.
 //!
 //! A recycled buffer keeps its old values: only callers that overwrite every entry may take one
-//! (`resolve_frame` does: every pixel belongs to exactly one tile, which writes it; the sort-last
+//! (`draw` in `mod.rs` does: every pixel belongs to exactly one tile, which writes it; the sort-last
 //! scan fills a kept key buffer before using it). Outputs therefore never depend on what the
 //! pool holds. The pool is bounded ([`KEEP_FRAMES`] frames' worth of buffers, each at least
 //! [`MIN_LEN`] entries).

@@ -141,7 +141,7 @@ mod tests {
 
     use glam::Vec3;
 
-    use super::super::resolve::{Pass, Visibility};
+    use super::super::pass::{Pass, Visibility};
     use super::super::{Frame, RenderScene, RenderSettings, SamplePattern, Shading, with_threads};
     use crate::mesh::{Mesh, shapes};
     use crate::scene::{Camera, Rig};
@@ -154,7 +154,7 @@ mod tests {
         visibility: Visibility,
     ) -> (Frame, bool) {
         let pass = Pass::new(scene, camera, settings, visibility);
-        let frame = pass.resolve_frame(&pass.context(None));
+        let frame = super::super::draw(&pass, &pass.context(None));
         (frame, pass.is_sort_last())
     }
 
