@@ -102,160 +102,182 @@ fn named_meshes(paths: &[PathBuf]) -> Result<Vec<(String, lodeval::mesh::Mesh)>,
 
 /// Run `bench`.
 pub(crate) fn run(a: BenchArgs) -> Result<(), Error> {
-    if a.what == BenchTarget::Metrics {
-        let [reference, test] = a.images.as_slice() else {
-            return Err(Error::Usage(
-                "lodeval bench metrics REF TEST: give two images".into(),
-            ));
-        };
-        let rows = lodeval::app::bench::bench_metrics(reference, test, a.runs)?;
-        return emit_json(&rows);
+    match a.what {
+        BenchTarget::Metrics => metrics(&a),
+        BenchTarget::Williams => williams(&a),
+        BenchTarget::Optimize => optimize(&a),
+        BenchTarget::MenzelGuthe => menzel_guthe(&a),
+        BenchTarget::Simplify => simplify(&a),
+        BenchTarget::Raster => raster(a),
     }
-    if a.what == BenchTarget::Williams {
-        let mut t = String::from(
-            "| mesh | triangles | MT nodes | hierarchy s | preprocess s | budget | frames | adapt ms median | p95 | max | first frame ms | nodes changed per frame (median) |\n|---|---|---|---|---|---|---|---|---|---|---|---|\n",
-        );
-        for (name, mesh) in named_meshes(&a.images)? {
-            let ratios = if a.ratios.is_empty() {
-                vec![0.5, 0.1, 0.01]
-            } else {
-                a.ratios.clone()
-            };
-            for r in lodeval::app::bench::bench_williams(&mesh, &ratios, a.views)? {
-                t.push_str(&format!(
-                    "| {name} | {} | {} | {:.2} | {:.2} | {} | {} | {:.2} | {:.2} | {:.2} | {:.2} | {} |\n",
-                    r.triangles,
-                    r.nodes,
-                    r.hierarchy_seconds,
-                    r.preprocess_seconds,
-                    r.budget,
-                    r.frames,
-                    r.median_ms,
-                    r.p95_ms,
-                    r.max_ms,
-                    r.first_ms,
-                    r.median_changes
-                ));
-            }
-        }
-        return emit(&t);
-    }
-    if a.what == BenchTarget::Optimize {
-        let meshes = named_meshes(&a.images)?;
-        if meshes.is_empty() {
-            return Err(Error::Usage(
-                "lodeval bench optimize MESH...: give at least one mesh".into(),
-            ));
-        }
-        let rows = lodeval::app::bench::bench_optimize(&meshes, a.triangles, a.evals, a.runs)?;
-        if a.json {
-            return emit_json(&rows);
-        }
-        let mut t = String::from(
-            "| mesh | input triangles | LOD triangles | LOD vertices | views | size | threads | evaluations | runs | best /s | median /s | worst /s | set-up s |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|\n",
-        );
-        for r in &rows {
-            t.push_str(&format!(
-                "| {} | {} | {} | {} | {} | {} | {} | {} | {} | {:.0} | {:.0} | {:.0} | {:.2} |\n",
-                r.mesh,
-                r.input_triangles,
-                r.triangles,
-                r.vertices,
-                r.views,
-                r.size,
-                r.threads,
-                r.evaluations,
-                r.runs,
-                r.best_per_s,
-                r.median_per_s,
-                r.worst_per_s,
-                r.setup_seconds
-            ));
-        }
-        return emit(&t);
-    }
-    if a.what == BenchTarget::MenzelGuthe {
-        let meshes = named_meshes(&a.images)?;
-        if meshes.is_empty() {
-            return Err(Error::Usage(
-                "lodeval bench menzel-guthe MESH...: give at least one mesh".into(),
-            ));
-        }
-        let ratio = a.ratios.first().copied().unwrap_or(0.1);
-        if !(ratio > 0.0 && ratio < 1.0) {
-            return Err(Error::Usage(format!(
-                "--ratios {ratio}: use a value in (0, 1)"
-            )));
-        }
-        let rows = lodeval::app::bench::bench_menzel_guthe(&meshes, ratio, a.runs)?;
-        if a.json {
-            return emit_json(&rows);
-        }
-        let mut t = String::from(
-            "| mesh | input triangles | LOD triangles | threads | runs | collapses | perception tests | Hausdorff tests | postponed | collapses/s best | median | worst | set-up s | QEM collapses/s |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n",
-        );
-        for r in &rows {
-            t.push_str(&format!(
-                "| {} | {} | {} | {} | {} | {} | {} | {} | {} | {:.0} | {:.0} | {:.0} | {:.2} | {:.0} |\n",
-                r.mesh,
-                r.input_triangles,
-                r.triangles,
-                r.threads,
-                r.runs,
-                r.collapses,
-                r.perception_tests,
-                r.hausdorff_tests,
-                r.postponed,
-                r.collapses_per_second,
-                r.median_collapses_per_second,
-                r.worst_collapses_per_second,
-                r.setup_seconds,
-                r.qem_collapses_per_second
-            ));
-        }
-        return emit(&t);
-    }
-    if a.what == BenchTarget::Simplify {
-        let mut meshes = named_meshes(&a.images)?;
-        if a.bumpy > 0 {
-            let triangles = 20u64.saturating_mul(4u64.saturating_pow(a.bumpy));
-            lodeval::limits::GENERATED_TRIANGLES
-                .check("the --bumpy sphere (20 × 4^N triangles):", triangles)
-                .map_err(Error::Usage)?;
-            meshes.push((
-                format!("bumpy-sphere-s{}", a.bumpy),
-                lodeval::mesh::shapes::bumpy_sphere(a.bumpy),
-            ));
-        }
+}
+
+/// `bench metrics REF TEST`: the metrics on one image pair, as JSON.
+fn metrics(a: &BenchArgs) -> Result<(), Error> {
+    let [reference, test] = a.images.as_slice() else {
+        return Err(Error::Usage(
+            "lodeval bench metrics REF TEST: give two images".into(),
+        ));
+    };
+    let rows = lodeval::app::bench::bench_metrics(reference, test, a.runs)?;
+    return emit_json(&rows);
+}
+
+/// `bench williams MESH...`: preprocessing and per-frame cut adaptation, as a table.
+fn williams(a: &BenchArgs) -> Result<(), Error> {
+    let mut t = String::from(
+        "| mesh | triangles | MT nodes | hierarchy s | preprocess s | budget | frames | adapt ms median | p95 | max | first frame ms | nodes changed per frame (median) |\n|---|---|---|---|---|---|---|---|---|---|---|---|\n",
+    );
+    for (name, mesh) in named_meshes(&a.images)? {
         let ratios = if a.ratios.is_empty() {
             vec![0.5, 0.1, 0.01]
         } else {
             a.ratios.clone()
         };
-        let rows = lodeval::app::bench::bench_simplify(&meshes, &ratios, 1_000_000, a.runs)?;
-        if a.json {
-            return emit_json(&rows);
-        }
-        let mut t = String::from(
-            "| mesh | input triangles | method | ratio | triangles | best s | median s | M input tri/s (best) | Hausdorff / diagonal | mean / diagonal |\n|---|---|---|---|---|---|---|---|---|---|\n",
-        );
-        for r in &rows {
+        for r in lodeval::app::bench::bench_williams(&mesh, &ratios, a.views)? {
             t.push_str(&format!(
-                "| {} | {} | {} | {} | {} | {:.4} | {:.4} | {:.2} | {:.3e} | {:.3e} |\n",
-                r.mesh,
-                r.input_triangles,
-                r.method,
-                r.ratio,
+                "| {name} | {} | {} | {:.2} | {:.2} | {} | {} | {:.2} | {:.2} | {:.2} | {:.2} | {} |\n",
                 r.triangles,
-                r.seconds,
-                r.median_seconds,
-                r.mtri_per_s,
-                r.hausdorff_relative,
-                r.mean_relative
+                r.nodes,
+                r.hierarchy_seconds,
+                r.preprocess_seconds,
+                r.budget,
+                r.frames,
+                r.median_ms,
+                r.p95_ms,
+                r.max_ms,
+                r.first_ms,
+                r.median_changes
             ));
         }
-        return emit(&t);
     }
+    return emit(&t);
+}
+
+/// `bench optimize MESH...`: the optimizer's evaluations per second.
+fn optimize(a: &BenchArgs) -> Result<(), Error> {
+    let meshes = named_meshes(&a.images)?;
+    if meshes.is_empty() {
+        return Err(Error::Usage(
+            "lodeval bench optimize MESH...: give at least one mesh".into(),
+        ));
+    }
+    let rows = lodeval::app::bench::bench_optimize(&meshes, a.triangles, a.evals, a.runs)?;
+    if a.json {
+        return emit_json(&rows);
+    }
+    let mut t = String::from(
+        "| mesh | input triangles | LOD triangles | LOD vertices | views | size | threads | evaluations | runs | best /s | median /s | worst /s | set-up s |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|\n",
+    );
+    for r in &rows {
+        t.push_str(&format!(
+            "| {} | {} | {} | {} | {} | {} | {} | {} | {} | {:.0} | {:.0} | {:.0} | {:.2} |\n",
+            r.mesh,
+            r.input_triangles,
+            r.triangles,
+            r.vertices,
+            r.views,
+            r.size,
+            r.threads,
+            r.evaluations,
+            r.runs,
+            r.best_per_s,
+            r.median_per_s,
+            r.worst_per_s,
+            r.setup_seconds
+        ));
+    }
+    return emit(&t);
+}
+
+/// `bench menzel-guthe MESH...`: applied collapses per second beside our QEM's.
+fn menzel_guthe(a: &BenchArgs) -> Result<(), Error> {
+    let meshes = named_meshes(&a.images)?;
+    if meshes.is_empty() {
+        return Err(Error::Usage(
+            "lodeval bench menzel-guthe MESH...: give at least one mesh".into(),
+        ));
+    }
+    let ratio = a.ratios.first().copied().unwrap_or(0.1);
+    if !(ratio > 0.0 && ratio < 1.0) {
+        return Err(Error::Usage(format!(
+            "--ratios {ratio}: use a value in (0, 1)"
+        )));
+    }
+    let rows = lodeval::app::bench::bench_menzel_guthe(&meshes, ratio, a.runs)?;
+    if a.json {
+        return emit_json(&rows);
+    }
+    let mut t = String::from(
+        "| mesh | input triangles | LOD triangles | threads | runs | collapses | perception tests | Hausdorff tests | postponed | collapses/s best | median | worst | set-up s | QEM collapses/s |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n",
+    );
+    for r in &rows {
+        t.push_str(&format!(
+            "| {} | {} | {} | {} | {} | {} | {} | {} | {} | {:.0} | {:.0} | {:.0} | {:.2} | {:.0} |\n",
+            r.mesh,
+            r.input_triangles,
+            r.triangles,
+            r.threads,
+            r.runs,
+            r.collapses,
+            r.perception_tests,
+            r.hausdorff_tests,
+            r.postponed,
+            r.collapses_per_second,
+            r.median_collapses_per_second,
+            r.worst_collapses_per_second,
+            r.setup_seconds,
+            r.qem_collapses_per_second
+        ));
+    }
+    return emit(&t);
+}
+
+/// `bench simplify MESH...`: every simplifier at each ratio.
+fn simplify(a: &BenchArgs) -> Result<(), Error> {
+    let mut meshes = named_meshes(&a.images)?;
+    if a.bumpy > 0 {
+        let triangles = 20u64.saturating_mul(4u64.saturating_pow(a.bumpy));
+        lodeval::limits::GENERATED_TRIANGLES
+            .check("the --bumpy sphere (20 × 4^N triangles):", triangles)
+            .map_err(Error::Usage)?;
+        meshes.push((
+            format!("bumpy-sphere-s{}", a.bumpy),
+            lodeval::mesh::shapes::bumpy_sphere(a.bumpy),
+        ));
+    }
+    let ratios = if a.ratios.is_empty() {
+        vec![0.5, 0.1, 0.01]
+    } else {
+        a.ratios.clone()
+    };
+    let rows = lodeval::app::bench::bench_simplify(&meshes, &ratios, 1_000_000, a.runs)?;
+    if a.json {
+        return emit_json(&rows);
+    }
+    let mut t = String::from(
+        "| mesh | input triangles | method | ratio | triangles | best s | median s | M input tri/s (best) | Hausdorff / diagonal | mean / diagonal |\n|---|---|---|---|---|---|---|---|---|---|\n",
+    );
+    for r in &rows {
+        t.push_str(&format!(
+            "| {} | {} | {} | {} | {} | {:.4} | {:.4} | {:.2} | {:.3e} | {:.3e} |\n",
+            r.mesh,
+            r.input_triangles,
+            r.method,
+            r.ratio,
+            r.triangles,
+            r.seconds,
+            r.median_seconds,
+            r.mtri_per_s,
+            r.hausdorff_relative,
+            r.mean_relative
+        ));
+    }
+    return emit(&t);
+}
+
+/// `bench raster`: the rasterizer on a large torus.
+fn raster(a: BenchArgs) -> Result<(), Error> {
     let job = lodeval::app::bench::RasterBench {
         rings: a.rings,
         sides: a.sides,

@@ -140,7 +140,6 @@ pub fn write(path: &std::path::Path, chart: &Chart) -> Result<()> {
 pub fn render(chart: &Chart) -> Pixmap {
     let mut pm = Pixmap::new(WIDTH, HEIGHT).expect("a fixed, non-zero size");
     pm.fill(Color::WHITE);
-    let (x0, x1, y0, y1) = (LEFT, WIDTH as f32 - RIGHT, TOP, HEIGHT as f32 - BOTTOM);
     label::draw_pixmap(&mut pm, &chart.title, LEFT, 26.0, Style::new(17.0, INK));
     if !chart.subtitle.is_empty() {
         label::draw_pixmap(
@@ -151,11 +150,25 @@ pub fn render(chart: &Chart) -> Pixmap {
             Style::new(12.0, MUTED),
         );
     }
-    let lines: Vec<Vec<(f64, f64, Option<&str>)>> = chart
+    let lines = plotted_points(chart);
+    let area = Area::new(chart, &lines);
+    draw_grid(&mut pm, &area, chart);
+    draw_marks(&mut pm, &area, chart);
+    draw_series(&mut pm, &area, chart, &lines);
+    pm
+}
+
+/// A series' points that can be drawn (finite, positive x on a log axis), sorted by x, each with
+/// its label.
+type Points<'a> = Vec<(f64, f64, Option<&'a str>)>;
+
+/// Every line's drawable points.
+fn plotted_points(chart: &Chart) -> Vec<Points<'_>> {
+    chart
         .lines
         .iter()
         .map(|l| {
-            let mut pts: Vec<(f64, f64, Option<&str>)> = l
+            let mut pts: Points = l
                 .points
                 .iter()
                 .enumerate()
@@ -165,45 +178,71 @@ pub fn render(chart: &Chart) -> Pixmap {
             pts.sort_by(|a, b| a.0.total_cmp(&b.0));
             pts
         })
-        .collect();
-    let xs = lines
-        .iter()
-        .flatten()
-        .map(|p| p.0)
-        .chain(chart.v_marks.iter().map(|m| m.at))
-        .filter(|x| x.is_finite() && (!chart.log_x || *x > 0.0));
-    let ys = lines
-        .iter()
-        .flatten()
-        .map(|p| p.1)
-        .chain(chart.h_marks.iter().map(|m| m.at))
-        .filter(|y| y.is_finite());
-    let x_axis = Axis::x(xs, chart.log_x);
-    let y_axis = Axis::y(ys, chart.tight_y);
-    let px = |x: f64| x0 + x_axis.fraction(x) as f32 * (x1 - x0);
-    let py = |y: f64| y1 - y_axis.fraction(y) as f32 * (y1 - y0);
+        .collect()
+}
 
+/// The plot area in pixels and its two axes.
+struct Area {
+    x0: f32,
+    x1: f32,
+    y0: f32,
+    y1: f32,
+    x_axis: Axis,
+    y_axis: Axis,
+}
+
+impl Area {
+    /// The axes fitted to the points and the marks.
+    fn new(chart: &Chart, lines: &[Points<'_>]) -> Area {
+        let xs = lines
+            .iter()
+            .flatten()
+            .map(|p| p.0)
+            .chain(chart.v_marks.iter().map(|m| m.at))
+            .filter(|x| x.is_finite() && (!chart.log_x || *x > 0.0));
+        let ys = lines
+            .iter()
+            .flatten()
+            .map(|p| p.1)
+            .chain(chart.h_marks.iter().map(|m| m.at))
+            .filter(|y| y.is_finite());
+        Area {
+            x0: LEFT,
+            x1: WIDTH as f32 - RIGHT,
+            y0: TOP,
+            y1: HEIGHT as f32 - BOTTOM,
+            x_axis: Axis::x(xs, chart.log_x),
+            y_axis: Axis::y(ys, chart.tight_y),
+        }
+    }
+
+    fn px(&self, x: f64) -> f32 {
+        self.x0 + self.x_axis.fraction(x) as f32 * (self.x1 - self.x0)
+    }
+
+    fn py(&self, y: f64) -> f32 {
+        self.y1 - self.y_axis.fraction(y) as f32 * (self.y1 - self.y0)
+    }
+}
+
+/// Grid, ticks, the frame and the axis titles.
+fn draw_grid(pm: &mut Pixmap, area: &Area, chart: &Chart) {
+    let (x0, x1, y0, y1) = (area.x0, area.x1, area.y0, area.y1);
     // Grid and ticks.
     let grid = paint([230, 230, 230]);
     let tick_style = Style::new(12.0, INK);
-    for (x, text) in x_axis.ticks() {
-        let sx = px(x);
-        stroke_line(&mut pm, (sx, y0), (sx, y1), &grid, 1.0, false);
+    for (x, text) in area.x_axis.ticks() {
+        let sx = area.px(x);
+        stroke_line(pm, (sx, y0), (sx, y1), &grid, 1.0, false);
         if !text.is_empty() {
-            label::draw_pixmap(
-                &mut pm,
-                &text,
-                sx,
-                y1 + 18.0,
-                tick_style.align(Align::Center),
-            );
+            label::draw_pixmap(pm, &text, sx, y1 + 18.0, tick_style.align(Align::Center));
         }
     }
-    for (y, text) in y_axis.ticks() {
-        let sy = py(y);
-        stroke_line(&mut pm, (x0, sy), (x1, sy), &grid, 1.0, false);
+    for (y, text) in area.y_axis.ticks() {
+        let sy = area.py(y);
+        stroke_line(pm, (x0, sy), (x1, sy), &grid, 1.0, false);
         label::draw_pixmap(
-            &mut pm,
+            pm,
             &text,
             x0 - 6.0,
             sy + 4.0,
@@ -219,37 +258,45 @@ pub fn render(chart: &Chart) -> Pixmap {
         None,
     );
     label::draw_pixmap(
-        &mut pm,
+        pm,
         &chart.x_label,
         (x0 + x1) / 2.0,
         HEIGHT as f32 - 14.0,
         Style::new(13.0, INK).align(Align::Center),
     );
     label::draw_pixmap(
-        &mut pm,
+        pm,
         &chart.y_label,
         22.0,
         (y0 + y1) / 2.0,
         Style::new(13.0, INK).align(Align::Center).vertical(),
     );
+}
 
+/// Reference lines, under the data.
+fn draw_marks(pm: &mut Pixmap, area: &Area, chart: &Chart) {
+    let (x0, x1, y0, y1) = (area.x0, area.x1, area.y0, area.y1);
     // Reference lines under the data.
     let mark = paint([150, 150, 150]);
     let mark_style = Style::new(11.0, MUTED);
     for m in chart.h_marks.iter().filter(|m| m.at.is_finite()) {
-        let sy = py(m.at);
-        stroke_line(&mut pm, (x0, sy), (x1, sy), &mark, 1.5, true);
-        label::draw_pixmap(&mut pm, &m.label, x0 + 6.0, sy - 5.0, mark_style);
+        let sy = area.py(m.at);
+        stroke_line(pm, (x0, sy), (x1, sy), &mark, 1.5, true);
+        label::draw_pixmap(pm, &m.label, x0 + 6.0, sy - 5.0, mark_style);
     }
     for m in chart.v_marks.iter().filter(|m| m.at.is_finite()) {
         if chart.log_x && m.at <= 0.0 {
             continue;
         }
-        let sx = px(m.at);
-        stroke_line(&mut pm, (sx, y0), (sx, y1), &mark, 1.5, true);
-        label::draw_pixmap(&mut pm, &m.label, sx - 5.0, y1 - 6.0, mark_style.vertical());
+        let sx = area.px(m.at);
+        stroke_line(pm, (sx, y0), (sx, y1), &mark, 1.5, true);
+        label::draw_pixmap(pm, &m.label, sx - 5.0, y1 - 6.0, mark_style.vertical());
     }
+}
 
+/// Series, point labels and the legend.
+fn draw_series(pm: &mut Pixmap, area: &Area, chart: &Chart, lines: &[Points<'_>]) {
+    let (x0, x1, y0, y1) = (area.x0, area.x1, area.y0, area.y1);
     // Series, point labels and the legend.
     let share = if chart.lines.iter().any(|l| l.dashed) {
         2
@@ -257,14 +304,14 @@ pub fn render(chart: &Chart) -> Pixmap {
         1
     };
     let pclip = Rect::from_ltrb(x0 - 6.0, y0 - 6.0, x1 + 6.0, y1 + 6.0).expect("non-empty");
-    for (k, (line, pts)) in chart.lines.iter().zip(&lines).enumerate() {
+    for (k, (line, pts)) in chart.lines.iter().zip(lines).enumerate() {
         let color = hex(COLORS[(k / share) % COLORS.len()]);
         let ink = paint(color);
         if pts.len() > 1 {
             let mut pb = PathBuilder::new();
-            pb.move_to(px(pts[0].0), py(pts[0].1));
+            pb.move_to(area.px(pts[0].0), area.py(pts[0].1));
             for p in &pts[1..] {
-                pb.line_to(px(p.0), py(p.1));
+                pb.line_to(area.px(p.0), area.py(p.1));
             }
             if let Some(path) = pb.finish() {
                 pm.stroke_path(
@@ -277,7 +324,7 @@ pub fn render(chart: &Chart) -> Pixmap {
             }
         }
         for &(x, y, text) in pts {
-            let (sx, sy) = (px(x), py(y));
+            let (sx, sy) = (area.px(x), area.py(y));
             if sx < pclip.left() || sx > pclip.right() || sy < pclip.top() || sy > pclip.bottom() {
                 continue;
             }
@@ -291,27 +338,13 @@ pub fn render(chart: &Chart) -> Pixmap {
                 // Even series label above their points, odd ones below, so two series' labels
                 // at the same x do not print over each other.
                 let dy = if k % 2 == 0 { -6.0 } else { 15.0 };
-                label::draw_pixmap(&mut pm, text, sx + 6.0, sy + dy, Style::new(11.0, color));
+                label::draw_pixmap(pm, text, sx + 6.0, sy + dy, Style::new(11.0, color));
             }
         }
         let ly = y0 + 8.0 + 20.0 * k as f32;
-        stroke_line(
-            &mut pm,
-            (x1 + 12.0, ly),
-            (x1 + 40.0, ly),
-            &ink,
-            2.0,
-            line.dashed,
-        );
-        label::draw_pixmap(
-            &mut pm,
-            &line.name,
-            x1 + 46.0,
-            ly + 4.0,
-            Style::new(12.0, INK),
-        );
+        stroke_line(pm, (x1 + 12.0, ly), (x1 + 40.0, ly), &ink, 2.0, line.dashed);
+        label::draw_pixmap(pm, &line.name, x1 + 46.0, ly + 4.0, Style::new(12.0, INK));
     }
-    pm
 }
 
 /// One axis: its data range and how values map onto it.

@@ -116,6 +116,33 @@ impl View {
             .filter_map(|t| self.old_box(t))
     }
 
+    /// The changed triangles set up anew into `scratch.pieces` (a triangle clipped into
+    /// several pieces gets each), with each triangle's new box in `scratch.bbox`.
+    fn set_up_changed(&self, mesh: &Adjacency, change: &Change, scratch: &mut Scratch) {
+        for &t in change.triangles {
+            let mut bb: Option<[i32; 4]> = None;
+            if mesh.is_alive(t) {
+                let setup = &mut scratch.setup;
+                setup.tris.clear();
+                setup.clipped.clear();
+                setup_one(t, mesh.triangle(t), &self.xf, &self.planes, self.vp, setup);
+                for st in &setup.tris {
+                    let corners = crate::raster::setup::Corners::decode(st.corners, &setup.clipped);
+                    scratch.pieces.push((
+                        t,
+                        Piece {
+                            st: *st,
+                            corners,
+                            shading: PieceShading::Unknown,
+                        },
+                    ));
+                    bb = Some(union(bb, st.bbox()));
+                }
+            }
+            scratch.bbox.push((t, bb));
+        }
+    }
+
     /// New set-up of the changed triangles and the dirty rectangle; false if it is empty.
     pub(super) fn prepare(
         &self,
@@ -161,28 +188,7 @@ impl View {
             }
         }
         scratch.old_boxes = (rect, box_area);
-        for &t in change.triangles {
-            let mut bb: Option<[i32; 4]> = None;
-            if mesh.is_alive(t) {
-                let setup = &mut scratch.setup;
-                setup.tris.clear();
-                setup.clipped.clear();
-                setup_one(t, mesh.triangle(t), &self.xf, &self.planes, self.vp, setup);
-                for st in &setup.tris {
-                    let corners = crate::raster::setup::Corners::decode(st.corners, &setup.clipped);
-                    scratch.pieces.push((
-                        t,
-                        Piece {
-                            st: *st,
-                            corners,
-                            shading: PieceShading::Unknown,
-                        },
-                    ));
-                    bb = Some(union(bb, st.bbox()));
-                }
-            }
-            scratch.bbox.push((t, bb));
-        }
+        self.set_up_changed(mesh, change, scratch);
         // Where nothing that changed shows now, the committed depths stay, and a new piece
         // behind all of them in every tile it touches (the far side of a closed mesh) cannot
         // change a pixel: the view then often has nothing to render at all.
@@ -259,144 +265,176 @@ impl View {
             // Nothing to render, or the first render (which only a commit makes).
             return 0;
         }
+        scratch.pixels_for(self.px.len());
+        scratch.touched.clear();
+        if scratch.fills_hold {
+            // The same triangles changed as in the last trial, on the same committed state.
+            scratch.touched.extend_from_slice(&self.fills.touched);
+            for (i, e) in scratch.touched.iter().enumerate() {
+                scratch.pixel[e.p as usize] = [scratch.number, i as u32];
+            }
+        } else {
+            // 1. The holes and the re-shaded pixels.
+            let (deep, reshaded_committed) = self.find_holes(shared, scratch);
+            if let Some(h) = deep {
+                self.fill_deep_holes(shared, scratch, h);
+            }
+            self.fills.touched.extend_from_slice(&scratch.touched);
+            self.fills.reshaded_committed = reshaded_committed;
+            self.fills.group(&mut scratch.reshaded_scan);
+        }
+        // 2. The changed triangles' new pieces.
+        self.scan_new_pieces(shared, scratch);
+        // 3. Shade and compare.
+        self.shade_and_compare(shared, mesh, scratch)
+    }
+
+    /// Step 1 of [`View::render`]: the holes, pixels a changed triangle showed (the second layer
+    /// shows there now), and the pixels of re-shaded triangles (their pieces stay, their shading
+    /// changes), found in the old boxes of those that show anywhere, visited once each. One pass
+    /// over the boxes' union where that is smaller than the boxes together (they overlap around
+    /// a moved vertex), else box by box. Returns the box of the holes three changed layers deep
+    /// and the committed error of the re-shaded pixels.
+    fn find_holes(&mut self, shared: &Shared, scratch: &mut Scratch) -> (Option<[i32; 4]>, i64) {
         let number = scratch.number;
         let reshade = number | RESHADE;
         let w = shared.width as usize;
-        scratch.pixels_for(self.px.len());
         let Scratch {
-            pieces: new_pieces,
             bbox: changed,
             reshaded_shown,
-            shows_now,
-            fills_hold,
             stamp,
-            first_piece,
-            visited,
-            reshade_at,
-            candidates,
-            reshading,
             pixel,
             touched,
             reshaded_scan,
             old_boxes,
-            plane_cache,
             ..
         } = scratch;
-        touched.clear();
         let changed_piece = |id: u32| id != EMPTY && stamp[(id >> PIECE_BITS) as usize] == number;
-        if *fills_hold {
-            // The same triangles changed as in the last trial, on the same committed state.
-            touched.extend_from_slice(&self.fills.touched);
-            for (i, e) in touched.iter().enumerate() {
-                pixel[e.p as usize] = [number, i as u32];
+        self.fills.start(self.commits, changed, reshaded_shown);
+        reshaded_scan.clear();
+        let mut reshaded_committed = 0i64;
+        let mut deep: Option<[i32; 4]> = None;
+        let (union_box, box_area) = *old_boxes;
+        let mut visit = |p: usize, x: i32, y: i32| {
+            let c = &self.px[p];
+            if c.shown == EMPTY || pixel[p][0] == number {
+                return;
             }
-        } else {
-            // 1. Holes, the pixels a changed triangle showed (the second layer shows there now),
-            //    and the pixels of re-shaded triangles (their pieces stay, their shading changes):
-            //    found in the old boxes of those that show anywhere, visited once each. One pass over
-            //    the boxes' union where that is smaller than the boxes together (they overlap around
-            //    a moved vertex), else box by box.
-            self.fills.start(self.commits, changed, reshaded_shown);
-            reshaded_scan.clear();
-            let mut reshaded_committed = 0i64;
-            let mut deep: Option<[i32; 4]> = None;
-            let (union_box, box_area) = *old_boxes;
-            let mut visit = |p: usize, x: i32, y: i32| {
-                let c = &self.px[p];
-                if c.shown == EMPTY || pixel[p][0] == number {
-                    return;
-                }
-                let s = stamp[(c.shown >> PIECE_BITS) as usize];
-                let touch = if s == number {
-                    let [second, third] = self.second[p];
-                    let second = if changed_piece(second.shown) {
-                        third
-                    } else {
-                        second
-                    };
-                    if changed_piece(second.shown) {
-                        deep = Some(union(deep, [x, y, x + 1, y + 1]));
-                        Touch {
-                            p: p as u32,
-                            id: EMPTY,
-                            depth: f32::INFINITY,
-                            deep: true,
-                            won_reshaded: false,
-                        }
-                    } else {
-                        Touch {
-                            p: p as u32,
-                            id: second.shown,
-                            depth: second.depth,
-                            deep: false,
-                            won_reshaded: false,
-                        }
-                    }
-                } else if s == reshade {
-                    // Marked for this scan only (a trial marks the holes alone).
-                    pixel[p][0] = number;
-                    reshaded_committed += sq(c.target, c.current);
-                    reshaded_scan.push((c.shown, [x as u16, y as u16, c.target]));
-                    return;
+            let s = stamp[(c.shown >> PIECE_BITS) as usize];
+            let touch = if s == number {
+                let [second, third] = self.second[p];
+                let second = if changed_piece(second.shown) {
+                    third
                 } else {
-                    return;
+                    second
                 };
-                pixel[p] = [number, touched.len() as u32];
-                touched.push(touch);
-            };
-            let mut scan = |b: [i32; 4]| {
-                for y in b[1]..b[3] {
-                    let row = y as usize * w;
-                    for x in b[0]..b[2] {
-                        visit(row + x as usize, x, y);
+                if changed_piece(second.shown) {
+                    deep = Some(union(deep, [x, y, x + 1, y + 1]));
+                    Touch {
+                        p: p as u32,
+                        id: EMPTY,
+                        depth: f32::INFINITY,
+                        deep: true,
+                        won_reshaded: false,
+                    }
+                } else {
+                    Touch {
+                        p: p as u32,
+                        id: second.shown,
+                        depth: second.depth,
+                        deep: false,
+                        won_reshaded: false,
                     }
                 }
+            } else if s == reshade {
+                // Marked for this scan only (a trial marks the holes alone).
+                pixel[p][0] = number;
+                reshaded_committed += sq(c.target, c.current);
+                reshaded_scan.push((c.shown, [x as u16, y as u16, c.target]));
+                return;
+            } else {
+                return;
             };
-            match union_box {
-                Some(u) if area(u) <= box_area => scan(u),
-                _ => self
-                    .old_boxes(changed.iter().map(|&(t, _)| t), reshaded_shown)
-                    .for_each(scan),
+            pixel[p] = [number, touched.len() as u32];
+            touched.push(touch);
+        };
+        let mut scan = |b: [i32; 4]| {
+            for y in b[1]..b[3] {
+                let row = y as usize * w;
+                for x in b[0]..b[2] {
+                    visit(row + x as usize, x, y);
+                }
             }
-            for &(_, [x, y, _]) in reshaded_scan.iter() {
-                pixel[y as usize * w + x as usize][0] = 0;
+        };
+        match union_box {
+            Some(u) if area(u) <= box_area => scan(u),
+            _ => self
+                .old_boxes(changed.iter().map(|&(t, _)| t), reshaded_shown)
+                .for_each(scan),
+        }
+        for &(_, [x, y, _]) in reshaded_scan.iter() {
+            pixel[y as usize * w + x as usize][0] = 0;
+        }
+        (deep, reshaded_committed)
+    }
+
+    /// Holes three changed layers deep (a fold, a silhouette), inside `h`: the unchanged
+    /// triangles there, through the buckets, each once.
+    fn fill_deep_holes(&self, shared: &Shared, scratch: &mut Scratch, h: [i32; 4]) {
+        let number = scratch.number;
+        let w = shared.width as usize;
+        let Scratch {
+            stamp,
+            visited,
+            candidates,
+            pixel,
+            touched,
+            ..
+        } = scratch;
+        #[cfg(test)]
+        tests::DEEP_RENDERS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+        candidates.clear();
+        for tile in tiles(self.tiles_x, h) {
+            for entry in &self.buckets[tile] {
+                let tu = entry.tri as usize;
+                if entry.overlaps(h) && stamp[tu] != number && visited[tu] != number {
+                    visited[tu] = number;
+                    candidates.push(entry.tri);
+                }
             }
-            // Holes three changed layers deep (a fold, a silhouette): the unchanged triangles there,
-            // through the buckets, each once.
-            if let Some(h) = deep {
-                #[cfg(test)]
-                tests::DEEP_RENDERS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-                candidates.clear();
-                for tile in tiles(self.tiles_x, h) {
-                    for entry in &self.buckets[tile] {
-                        let tu = entry.tri as usize;
-                        if entry.overlaps(h) && stamp[tu] != number && visited[tu] != number {
-                            visited[tu] = number;
-                            candidates.push(entry.tri);
+        }
+        for &t in candidates.iter() {
+            for (k, p) in self.pieces[t as usize].iter().enumerate() {
+                let id = (t << PIECE_BITS) | k as u32;
+                edge::rasterize_each(&p.st, h, |x, y, depth| {
+                    let at = y as usize * w + x as usize;
+                    if pixel[at][0] == number {
+                        let e = &mut touched[pixel[at][1] as usize];
+                        if e.deep && nearer(depth, id, e.depth, e.id) {
+                            (e.depth, e.id) = (depth, id);
                         }
                     }
-                }
-                for &t in candidates.iter() {
-                    for (k, p) in self.pieces[t as usize].iter().enumerate() {
-                        let id = (t << PIECE_BITS) | k as u32;
-                        edge::rasterize_each(&p.st, h, |x, y, depth| {
-                            let at = y as usize * w + x as usize;
-                            if pixel[at][0] == number {
-                                let e = &mut touched[pixel[at][1] as usize];
-                                if e.deep && nearer(depth, id, e.depth, e.id) {
-                                    (e.depth, e.id) = (depth, id);
-                                }
-                            }
-                        });
-                    }
-                }
+                });
             }
-            self.fills.touched.extend_from_slice(touched);
-            self.fills.reshaded_committed = reshaded_committed;
-            self.fills.group(reshaded_scan);
         }
-        // 2. The changed triangles' new pieces. Where nothing that changed shows, no hole
-        //    opened, so a piece behind every committed depth of its tiles changes nothing.
+    }
+
+    /// Step 2 of [`View::render`]: the changed triangles' new pieces. Where nothing that changed
+    /// shows, no hole opened, so a piece behind every committed depth of its tiles changes
+    /// nothing.
+    fn scan_new_pieces(&self, shared: &Shared, scratch: &mut Scratch) {
+        let number = scratch.number;
+        let reshade = number | RESHADE;
+        let w = shared.width as usize;
+        let Scratch {
+            pieces: new_pieces,
+            shows_now,
+            stamp,
+            first_piece,
+            pixel,
+            touched,
+            ..
+        } = scratch;
         let full = [0, 0, shared.width as i32, shared.height as i32];
         for (k, (t, p)) in new_pieces.iter().enumerate() {
             if !*shows_now && hidden(&self.tile_far, self.tiles_x, &p.st) {
@@ -432,6 +470,26 @@ impl View {
                 }
             });
         }
+    }
+
+    /// Step 3 of [`View::render`]: shade and compare; returns ΔE.
+    fn shade_and_compare(
+        &mut self,
+        shared: &Shared,
+        mesh: &Adjacency,
+        scratch: &mut Scratch,
+    ) -> i64 {
+        let number = scratch.number;
+        let Scratch {
+            pieces: new_pieces,
+            stamp,
+            first_piece,
+            reshade_at,
+            reshading,
+            touched,
+            plane_cache,
+            ..
+        } = scratch;
         // Shade and compare. A pixel that still shows the same piece of an unchanged triangle
         // keeps its value (its corners and attributes are as committed); only pixels showing a
         // changed or re-shaded triangle, or another piece than before, are shaded.

@@ -132,12 +132,17 @@ impl Perception {
         } else {
             0.0
         };
-        let alpha = Vec3::new(tilt, 0.0, twist);
-        let k_min = o.curvature.k_min.min(s.curvature.k_min);
-        let k_max = o.curvature.k_max.min(s.curvature.k_max);
-        let torsion = o.curvature.torsion;
-        let turns = so.turns.max(ss.turns);
-        let zero = Slot::default();
+        let pair = Pair {
+            so: &so,
+            ss: &ss,
+            alpha: Vec3::new(tilt, 0.0, twist),
+            k_min: o.curvature.k_min.min(s.curvature.k_min),
+            k_max: o.curvature.k_max.min(s.curvature.k_max),
+            torsion: o.curvature.torsion,
+            turns: so.turns.max(ss.turns),
+            floor,
+            global,
+        };
         // Pass 1: every slot that could be seen farther than `known`, with its cheap bound.
         let mut candidates: Vec<Candidate> = Vec::new();
         let ln_peaks = self.sensitivity.each_ref().map(|s| s.peak.ln());
@@ -158,110 +163,149 @@ impl Perception {
             }
         };
         if Arc::ptr_eq(&so, &ss) {
-            // Equal inputs, equal spectra: a slot of amplitude a differs by δ = 2a·sin(φ/2), φ the
-            // rotation's phase at its degree. Masked by itself (m ≥ a), it can be seen only if
-            // a^s/δ ≤ C_peak^(1−s) (`Masking::least_sensitivity`), i.e. a ≥ a_min: whole degrees
-            // below it are skipped.
-            let slope = crate::metric::vdp::masking::SLOPE as f64;
-            for c in 0..3 {
-                let sens = &self.sensitivity[usize::from(c > 0)];
-                let visible = 1.0 / sens.peak as f32;
-                for w in 0..turns {
-                    for l in 0..=super::spectrum::DEGREE {
-                        let peak = so.degree_peak(c, w, l);
-                        if 2.0 * peak < visible {
-                            continue;
-                        }
-                        let phi = rotation::phase(alpha, l, w).min(std::f32::consts::PI);
-                        // (Divided by the threshold's multiple of a JND.)
-                        let factor = 2.0 * (0.5 * phi).sin() / self.jnd;
-                        if factor <= 0.0 {
-                            continue;
-                        }
-                        // Self-masked, the least sensitivity a slot of amplitude a needs is
-                        // max(1/δ, (a^s/δ)^(1/(1−s))) = k/a with k = max(1/factor,
-                        // factor^(−1/(1−s))); it is visible only where k/a ≤ C_peak.
-                        let k = if self.masking.is_on() {
-                            (1.0 / factor as f64).max((factor as f64).powf(-1.0 / (1.0 - slope)))
-                        } else {
-                            1.0 / factor as f64
-                        };
-                        let a_min = (k / sens.peak) as f32;
-                        if peak < a_min {
-                            continue;
-                        }
-                        let first = l * (l + 1) / 2;
-                        for m in 0..so.elevations {
-                            for h in first..=first + l {
-                                let a = so.slots[so.index(c, m, w, h)].amplitude;
-                                if a < a_min {
-                                    continue;
-                                }
-                                let omega = self.harmonics[h].1;
-                                let f = surface_frequency(
-                                    k_min, k_max, torsion, omega, w as f32, floor,
-                                ) as f64;
-                                let masker = masking::masker(global(c, f as f32), a, a);
-                                let delta = a * factor;
-                                let needed = if masker > a {
-                                    self.masking
-                                        .ln_least_sensitivity((delta as f64).ln(), masker as f64)
-                                } else {
-                                    (k / a as f64).ln()
-                                };
-                                consider(delta, masker, f, c > 0, needed);
-                            }
-                        }
-                    }
-                }
-            }
+            self.equal_spectra(&pair, &mut consider);
         } else {
-            for c in 0..3 {
-                let sens = &self.sensitivity[usize::from(c > 0)];
-                let visible = 1.0 / sens.peak as f32;
-                for m in 0..so.elevations {
-                    for w in 0..turns {
-                        for h in 0..HARMONICS {
-                            let s1 = if w < so.turns {
-                                &so.slots[so.index(c, m, w, h)]
-                            } else {
-                                &zero
-                            };
-                            let s2 = if w < ss.turns {
-                                &ss.slots[ss.index(c, m, w, h)]
-                            } else {
-                                &zero
-                            };
-                            let (a1, a2) = (s1.amplitude, s2.amplitude);
-                            if 2.0 * a1.max(a2) < visible {
+            self.differing_spectra(&pair, &mut consider);
+        }
+        self.solve(candidates, known)
+    }
+
+    /// Pass 1 where both points have the same inputs, so equal spectra: a slot of amplitude a
+    /// differs by δ = 2a·sin(φ/2), φ the rotation's phase at its degree. Masked by itself
+    /// (m ≥ a), it can be seen only if a^s/δ ≤ C_peak^(1−s) (`Masking::least_sensitivity`), i.e.
+    /// a ≥ a_min: whole degrees below it are skipped.
+    fn equal_spectra(&self, pair: &Pair<'_>, consider: &mut impl FnMut(f32, f32, f64, bool, f64)) {
+        let Pair {
+            so,
+            alpha,
+            k_min,
+            k_max,
+            torsion,
+            turns,
+            floor,
+            global,
+            ..
+        } = *pair;
+        let slope = crate::metric::vdp::masking::SLOPE as f64;
+        for c in 0..3 {
+            let sens = &self.sensitivity[usize::from(c > 0)];
+            let visible = 1.0 / sens.peak as f32;
+            for w in 0..turns {
+                for l in 0..=super::spectrum::DEGREE {
+                    let peak = so.degree_peak(c, w, l);
+                    if 2.0 * peak < visible {
+                        continue;
+                    }
+                    let phi = rotation::phase(alpha, l, w).min(std::f32::consts::PI);
+                    // (Divided by the threshold's multiple of a JND.)
+                    let factor = 2.0 * (0.5 * phi).sin() / self.jnd;
+                    if factor <= 0.0 {
+                        continue;
+                    }
+                    // Self-masked, the least sensitivity a slot of amplitude a needs is
+                    // max(1/δ, (a^s/δ)^(1/(1−s))) = k/a with k = max(1/factor,
+                    // factor^(−1/(1−s))); it is visible only where k/a ≤ C_peak.
+                    let k = if self.masking.is_on() {
+                        (1.0 / factor as f64).max((factor as f64).powf(-1.0 / (1.0 - slope)))
+                    } else {
+                        1.0 / factor as f64
+                    };
+                    let a_min = (k / sens.peak) as f32;
+                    if peak < a_min {
+                        continue;
+                    }
+                    let first = l * (l + 1) / 2;
+                    for m in 0..so.elevations {
+                        for h in first..=first + l {
+                            let a = so.slots[so.index(c, m, w, h)].amplitude;
+                            if a < a_min {
                                 continue;
                             }
-                            let (l, omega) = self.harmonics[h];
-                            let phi_s = if a1 > 0.0 && a2 > 0.0 {
-                                let d: f32 = s1.unit.iter().zip(&s2.unit).map(|(x, y)| x * y).sum();
-                                d.clamp(-1.0, 1.0).acos()
-                            } else {
-                                0.0
-                            };
-                            let delta =
-                                rotation::delta_max(a1, a2, rotation::phase(alpha, l, w) + phi_s)
-                                    / self.jnd;
-                            if delta < visible {
-                                continue;
-                            }
+                            let omega = self.harmonics[h].1;
                             let f = surface_frequency(k_min, k_max, torsion, omega, w as f32, floor)
                                 as f64;
-                            let masker = masking::masker(global(c, f as f32), a1, a2);
-                            let needed = self
-                                .masking
-                                .ln_least_sensitivity((delta as f64).ln(), masker as f64);
+                            let masker = masking::masker(global(c, f as f32), a, a);
+                            let delta = a * factor;
+                            let needed = if masker > a {
+                                self.masking
+                                    .ln_least_sensitivity((delta as f64).ln(), masker as f64)
+                            } else {
+                                (k / a as f64).ln()
+                            };
                             consider(delta, masker, f, c > 0, needed);
                         }
                     }
                 }
             }
         }
-        // Pass 2: the Newton iterations, largest bound first, until no bound can beat the best.
+    }
+
+    /// Pass 1 where the spectra differ: each slot's largest difference over the rotation.
+    fn differing_spectra(
+        &self,
+        pair: &Pair<'_>,
+        consider: &mut impl FnMut(f32, f32, f64, bool, f64),
+    ) {
+        let Pair {
+            so,
+            ss,
+            alpha,
+            k_min,
+            k_max,
+            torsion,
+            turns,
+            floor,
+            global,
+        } = *pair;
+        let zero = Slot::default();
+        for c in 0..3 {
+            let sens = &self.sensitivity[usize::from(c > 0)];
+            let visible = 1.0 / sens.peak as f32;
+            for m in 0..so.elevations {
+                for w in 0..turns {
+                    for h in 0..HARMONICS {
+                        let s1 = if w < so.turns {
+                            &so.slots[so.index(c, m, w, h)]
+                        } else {
+                            &zero
+                        };
+                        let s2 = if w < ss.turns {
+                            &ss.slots[ss.index(c, m, w, h)]
+                        } else {
+                            &zero
+                        };
+                        let (a1, a2) = (s1.amplitude, s2.amplitude);
+                        if 2.0 * a1.max(a2) < visible {
+                            continue;
+                        }
+                        let (l, omega) = self.harmonics[h];
+                        let phi_s = if a1 > 0.0 && a2 > 0.0 {
+                            let d: f32 = s1.unit.iter().zip(&s2.unit).map(|(x, y)| x * y).sum();
+                            d.clamp(-1.0, 1.0).acos()
+                        } else {
+                            0.0
+                        };
+                        let delta =
+                            rotation::delta_max(a1, a2, rotation::phase(alpha, l, w) + phi_s)
+                                / self.jnd;
+                        if delta < visible {
+                            continue;
+                        }
+                        let f =
+                            surface_frequency(k_min, k_max, torsion, omega, w as f32, floor) as f64;
+                        let masker = masking::masker(global(c, f as f32), a1, a2);
+                        let needed = self
+                            .masking
+                            .ln_least_sensitivity((delta as f64).ln(), masker as f64);
+                        consider(delta, masker, f, c > 0, needed);
+                    }
+                }
+            }
+        }
+    }
+
+    /// Pass 2: the Newton iterations, largest bound first, until no bound can beat the best.
+    fn solve(&self, mut candidates: Vec<Candidate>, known: f64) -> Comparison {
         candidates.sort_unstable_by(|x, y| {
             y.bound
                 .total_cmp(&x.bound)
@@ -288,6 +332,21 @@ impl Perception {
         }
         out
     }
+}
+
+/// What both passes of `compare` know about the pair of points.
+#[derive(Clone, Copy)]
+struct Pair<'a> {
+    so: &'a Spectrum,
+    ss: &'a Spectrum,
+    /// The rotation between the frames: (tilt, 0, twist).
+    alpha: Vec3,
+    k_min: f32,
+    k_max: f32,
+    torsion: f32,
+    turns: usize,
+    floor: f32,
+    global: &'a dyn Fn(usize, f32) -> f32,
 }
 
 /// A slot that may be visible beyond what is known, with the bound on its distance.
