@@ -124,13 +124,6 @@ struct PerTest<'a> {
 /// Run `diff`.
 pub(crate) fn run(a: DiffArgs) -> Result<(), Error> {
     let metrics = a.metric.metrics();
-    let viewing = match a.ppd {
-        Some(p) => lodeval::scene::Viewing::from_ppd(p),
-        None => {
-            lodeval::scene::Viewing::from_display(a.display_width_m, a.display_px, a.distance_m)
-        }
-    };
-    viewing.check().map_err(Error::Usage)?;
     // With `all`, metrics that do not apply to this image size report a note instead.
     let lenient = a.metric.0.is_none();
     let engine = lodeval::backend::Engine::new(a.backend)?;
@@ -141,12 +134,6 @@ pub(crate) fn run(a: DiffArgs) -> Result<(), Error> {
             .into_iter()
             .collect::<Vec<_>>(),
     );
-    let display = lodeval::metric::vdp::Display::new(
-        a.peak_cd_m2,
-        a.black_cd_m2,
-        a.ambient_lux,
-        a.reflectivity,
-    )?;
     let gates = lodeval::app::DiffGates {
         fail: a.fail,
         warn: a.warn,
@@ -175,7 +162,7 @@ pub(crate) fn run(a: DiffArgs) -> Result<(), Error> {
         .collect();
     let outputs: Vec<PathBuf> = a.csv.iter().chain(a.map.iter()).cloned().collect();
     lodeval::io::check_not_inputs(&outputs, &inputs)?;
-    let seen = lodeval::app::Seen { viewing, display };
+    let seen = seen(&a)?;
     let several = a.test.len() > 1;
     let mut all = Vec::new();
     for test in &a.test {
@@ -203,39 +190,100 @@ pub(crate) fn run(a: DiffArgs) -> Result<(), Error> {
         let (fail, warn) = gate_row.map_or((None, None), |r| lodeval::app::judge(r, &gates));
         all.push((test.clone(), results, fail, warn));
     }
-    let verdict = |fail: &Option<String>, warn: &Option<String>| {
-        if fail.is_some() {
-            "fail"
-        } else if warn.is_some() {
-            "warn"
-        } else {
-            "pass"
+    if let Some(path) = &a.csv {
+        write_csv(&a, path, &all, gated)?;
+    }
+    print(&a, &all)?;
+    let mut failed = Vec::new();
+    for (test, _, fail, warn) in &all {
+        if let Some(w) = warn
+            && fail.is_none()
+        {
+            note!("warning: {}: {w}", test.display());
+        }
+        if let Some(f) = fail {
+            failed.push(format!("{}: {f}", test.display()));
+        }
+    }
+    if failed.is_empty() {
+        Ok(())
+    } else {
+        Err(Error::Regression(failed.join("; ")))
+    }
+}
+
+/// One test image's results and the gate's verdict: (test, results, fail, warn).
+type Judged = (
+    PathBuf,
+    Vec<lodeval::app::DiffResult>,
+    Option<String>,
+    Option<String>,
+);
+
+/// `fail`, `warn` or `pass`.
+fn verdict(fail: &Option<String>, warn: &Option<String>) -> &'static str {
+    if fail.is_some() {
+        "fail"
+    } else if warn.is_some() {
+        "warn"
+    } else {
+        "pass"
+    }
+}
+
+/// The viewing geometry and the display, checked.
+fn seen(a: &DiffArgs) -> Result<lodeval::app::Seen, Error> {
+    let viewing = match a.ppd {
+        Some(p) => lodeval::scene::Viewing::from_ppd(p),
+        None => {
+            lodeval::scene::Viewing::from_display(a.display_width_m, a.display_px, a.distance_m)
         }
     };
-    if let Some(path) = &a.csv {
-        let mut rows = Vec::new();
-        for (test, results, fail, warn) in &all {
-            for r in results {
-                rows.push(CsvRow {
-                    reference: a.reference.display().to_string(),
-                    test: test.display().to_string(),
-                    metric: r.metric.name(),
-                    value: r.value,
-                    jnd: r.jnd,
-                    worst_x: r.worst_pixel.map(|w| w.x),
-                    worst_y: r.worst_pixel.map(|w| w.y),
-                    worst_value: r.worst_pixel.map(|w| w.value),
-                    share_over: r.share_over,
-                    verdict: if r.metric == gated {
-                        verdict(fail, warn)
-                    } else {
-                        ""
-                    },
-                });
-            }
+    viewing.check().map_err(Error::Usage)?;
+    let display = lodeval::metric::vdp::Display::new(
+        a.peak_cd_m2,
+        a.black_cd_m2,
+        a.ambient_lux,
+        a.reflectivity,
+    )?;
+    Ok(lodeval::app::Seen { viewing, display })
+}
+
+/// `--csv`: every result of every test image, with the gated metric's verdict.
+fn write_csv(
+    a: &DiffArgs,
+    path: &std::path::Path,
+    all: &[Judged],
+    gated: Metric,
+) -> Result<(), Error> {
+    let mut rows = Vec::new();
+    for (test, results, fail, warn) in all {
+        for r in results {
+            rows.push(CsvRow {
+                reference: a.reference.display().to_string(),
+                test: test.display().to_string(),
+                metric: r.metric.name(),
+                value: r.value,
+                jnd: r.jnd,
+                worst_x: r.worst_pixel.map(|w| w.x),
+                worst_y: r.worst_pixel.map(|w| w.y),
+                worst_value: r.worst_pixel.map(|w| w.value),
+                share_over: r.share_over,
+                verdict: if r.metric == gated {
+                    verdict(fail, warn)
+                } else {
+                    ""
+                },
+            });
         }
-        lodeval::io::csv::write_rows(path, None, &rows)?;
     }
+    lodeval::io::csv::write_rows(path, None, &rows)?;
+    Ok(())
+}
+
+/// The results as JSON (`--json`) or text.
+fn print(a: &DiffArgs, all: &[Judged]) -> Result<(), Error> {
+    let several = all.len() > 1;
     if a.json {
         if several {
             let per: Vec<PerTest> = all
@@ -253,7 +301,7 @@ pub(crate) fn run(a: DiffArgs) -> Result<(), Error> {
         }
     } else {
         let mut text = String::new();
-        for (test, results, _, _) in &all {
+        for (test, results, _, _) in all {
             if several {
                 text.push_str(&format!("{}:\n", test.display()));
             }
@@ -263,22 +311,7 @@ pub(crate) fn run(a: DiffArgs) -> Result<(), Error> {
         }
         emit(&text)?;
     }
-    let mut failed = Vec::new();
-    for (test, _, fail, warn) in &all {
-        if let Some(w) = warn
-            && fail.is_none()
-        {
-            note!("warning: {}: {w}", test.display());
-        }
-        if let Some(f) = fail {
-            failed.push(format!("{}: {f}", test.display()));
-        }
-    }
-    if failed.is_empty() {
-        Ok(())
-    } else {
-        Err(Error::Regression(failed.join("; ")))
-    }
+    Ok(())
 }
 
 /// One metric's line of text.

@@ -175,73 +175,16 @@ impl GpuScene {
                 "{tri_count} triangles are too many for one GPU draw; use --backend cpu"
             )));
         }
-        // Vertex records.
-        let mut vertices = vec![0f32; mesh.vertex_count() * VSTRIDE];
-        for (v, rec) in vertices.chunks_exact_mut(VSTRIDE).enumerate() {
-            rec[0..3].copy_from_slice(&mesh.positions()[v].to_array());
-            let m = prepared.vertex_material[v];
-            rec[3] = f32::from_bits(if m == u32::MAX { 0 } else { m });
-            rec[4..7].copy_from_slice(&mesh.normals()[v].to_array());
-            let t = prepared
-                .tangents
-                .as_ref()
-                .map_or(Vec4::new(0.0, 0.0, 0.0, 1.0), |t| t[v]);
-            rec[7] = t.w;
-            if let Some(uvs) = mesh.uvs() {
-                rec[8..10].copy_from_slice(&uvs[v].to_array());
-            }
-            let c = mesh.colors().map_or(Vec3::ONE, |c| c[v]);
-            rec[10..13].copy_from_slice(&c.to_array());
-            rec[13..16].copy_from_slice(&t.truncate().to_array());
-            if let Some(uvs) = mesh.uvs1() {
-                rec[16..18].copy_from_slice(&uvs[v].to_array());
-            }
-        }
+        let vertices = vertex_records(mesh, prepared);
         let tris: Vec<[u32; 4]> = mesh
             .triangles()
             .iter()
             .zip(mesh.material_ids())
             .map(|(t, &m)| [t[0], t[1], t[2], m])
             .collect();
-        // Texture pyramids, each decoded texture once (keyed by address; only looked up), packed
-        // into pages of at most one storage binding each.
-        let page_texels = (gpu.device.limits().max_storage_buffer_binding_size / 16) as usize;
-        let mut levels: Vec<GpuLevel> = Vec::new();
-        let mut pages: Vec<Vec<[f32; 4]>> = vec![Vec::new()];
-        let mut placed: Vec<(*const crate::raster::MipTexture, [u32; 2])> = Vec::new();
-        let mut place_levels = |key: *const crate::raster::MipTexture,
-                                all: &mut dyn Iterator<Item = (usize, usize, &[Vec3])>|
-         -> Result<[u32; 2]> {
-            if let Some((_, at)) = placed.iter().find(|(p, _)| *p == key) {
-                return Ok(*at);
-            }
-            let first = levels.len() as u32;
-            for (w, h, px) in all {
-                if px.len() > page_texels {
-                    return Err(too_big(w, h));
-                }
-                if pages.last().map_or(0, Vec::len) + px.len() > page_texels {
-                    pages.push(Vec::new());
-                }
-                if pages.len() > PAGES {
-                    return Err(too_big(w, h));
-                }
-                let index = (pages.len() - 1) as u32;
-                let page = pages.last_mut().expect("one page at least");
-                levels.push(GpuLevel {
-                    page: index,
-                    offset: page.len() as u32,
-                    width: w as u32,
-                    height: h as u32,
-                });
-                page.extend(px.iter().map(|c| c.extend(1.0).to_array()));
-            }
-            let at = [first, levels.len() as u32 - first];
-            if !key.is_null() {
-                placed.push((key, at));
-            }
-            Ok(at)
-        };
+        // Texture pyramids, each decoded texture once, packed into pages.
+        let mut texels =
+            Texels::new((gpu.device.limits().max_storage_buffer_binding_size / 16) as usize);
         let mut materials = Vec::with_capacity(mesh.materials().len());
         for (m, p) in mesh.materials().iter().zip(&prepared.materials) {
             let mut slots = [GpuSlot::zeroed(); 5];
@@ -254,7 +197,7 @@ impl GpuScene {
             ];
             for (out, s) in slots.iter_mut().zip(prepared_slots) {
                 if let Some(s) = s {
-                    let at = place_levels(Arc::as_ptr(&s.mip), &mut s.mip.levels())?;
+                    let at = texels.place(Arc::as_ptr(&s.mip), &mut s.mip.levels())?;
                     *out = gpu_slot(s, at);
                 }
             }
@@ -278,17 +221,20 @@ impl GpuScene {
         let ibl = crate::raster::ibl::prepared(&scene.environment);
         let maps = ibl.levels.iter().chain(std::iter::once(&ibl.irradiance));
         let mut chain = maps.map(|m| (m.width(), m.height(), m.texels()));
-        let chain_at = place_levels(std::ptr::null(), &mut chain)?;
+        let chain_at = texels.place(std::ptr::null(), &mut chain)?;
         let lut: Vec<Vec3> = crate::raster::ibl::BrdfLut::get()
             .entries()
             .iter()
             .map(|e| e.extend(0.0))
             .collect();
         let n = crate::raster::ibl::LUT_SIZE;
-        let lut_at = place_levels(
+        let lut_at = texels.place(
             std::ptr::null(),
             &mut std::iter::once((n, n, lut.as_slice())),
         )?;
+        let Texels {
+            levels, mut pages, ..
+        } = texels;
         let limit = gpu.device.limits().max_storage_buffer_binding_size;
         if (vertices.len() * 4) as u64 > limit || (tris.len() * 16) as u64 > limit {
             return Err(Error::Usage(format!(
@@ -594,6 +540,91 @@ impl GpuScene {
             coverage: px[..n].iter().map(|p| p[3]).collect(),
             triangle: aux[..n].iter().map(|a| a[1]).collect(),
         })
+    }
+}
+
+/// One record of `VSTRIDE` floats per vertex: position, material, normal, tangent sign, UV,
+/// colour, tangent, second UV set.
+fn vertex_records(mesh: &crate::mesh::Mesh, prepared: &crate::raster::PreparedMesh) -> Vec<f32> {
+    let mut vertices = vec![0f32; mesh.vertex_count() * VSTRIDE];
+    for (v, rec) in vertices.chunks_exact_mut(VSTRIDE).enumerate() {
+        rec[0..3].copy_from_slice(&mesh.positions()[v].to_array());
+        let m = prepared.vertex_material[v];
+        rec[3] = f32::from_bits(if m == u32::MAX { 0 } else { m });
+        rec[4..7].copy_from_slice(&mesh.normals()[v].to_array());
+        let t = prepared
+            .tangents
+            .as_ref()
+            .map_or(Vec4::new(0.0, 0.0, 0.0, 1.0), |t| t[v]);
+        rec[7] = t.w;
+        if let Some(uvs) = mesh.uvs() {
+            rec[8..10].copy_from_slice(&uvs[v].to_array());
+        }
+        let c = mesh.colors().map_or(Vec3::ONE, |c| c[v]);
+        rec[10..13].copy_from_slice(&c.to_array());
+        rec[13..16].copy_from_slice(&t.truncate().to_array());
+        if let Some(uvs) = mesh.uvs1() {
+            rec[16..18].copy_from_slice(&uvs[v].to_array());
+        }
+    }
+    vertices
+}
+
+/// Texture levels packed into pages of at most one storage binding each; each decoded texture
+/// placed once (keyed by address; only looked up).
+struct Texels {
+    page_texels: usize,
+    levels: Vec<GpuLevel>,
+    pages: Vec<Vec<[f32; 4]>>,
+    placed: Vec<(*const crate::raster::MipTexture, [u32; 2])>,
+}
+
+impl Texels {
+    fn new(page_texels: usize) -> Texels {
+        Texels {
+            page_texels,
+            levels: Vec::new(),
+            pages: vec![Vec::new()],
+            placed: Vec::new(),
+        }
+    }
+
+    /// Place a pyramid's levels (or find where `key`'s were placed); returns (first level,
+    /// level count). A null `key` is never looked up.
+    fn place(
+        &mut self,
+        key: *const crate::raster::MipTexture,
+        all: &mut dyn Iterator<Item = (usize, usize, &[Vec3])>,
+    ) -> Result<[u32; 2]> {
+        if let Some((_, at)) = self.placed.iter().find(|(p, _)| *p == key) {
+            return Ok(*at);
+        }
+        let first = self.levels.len() as u32;
+        for (w, h, px) in all {
+            if px.len() > self.page_texels {
+                return Err(too_big(w, h));
+            }
+            if self.pages.last().map_or(0, Vec::len) + px.len() > self.page_texels {
+                self.pages.push(Vec::new());
+            }
+            if self.pages.len() > PAGES {
+                return Err(too_big(w, h));
+            }
+            let index = (self.pages.len() - 1) as u32;
+            let page = self.pages.last_mut().expect("one page at least");
+            self.levels.push(GpuLevel {
+                page: index,
+                offset: page.len() as u32,
+                width: w as u32,
+                height: h as u32,
+            });
+            page.extend(px.iter().map(|c| c.extend(1.0).to_array()));
+        }
+        let at = [first, self.levels.len() as u32 - first];
+        if !key.is_null() {
+            self.placed.push((key, at));
+        }
+        Ok(at)
     }
 }
 
