@@ -120,7 +120,7 @@ fn metrics(a: &BenchArgs) -> Result<(), Error> {
         ));
     };
     let rows = lodeval::app::bench::bench_metrics(reference, test, a.runs)?;
-    return emit_json(&rows);
+    emit_json(&rows)
 }
 
 /// `bench williams MESH...`: preprocessing and per-frame cut adaptation, as a table.
@@ -151,7 +151,7 @@ fn williams(a: &BenchArgs) -> Result<(), Error> {
             ));
         }
     }
-    return emit(&t);
+    emit(&t)
 }
 
 /// `bench optimize MESH...`: the optimizer's evaluations per second.
@@ -187,7 +187,7 @@ fn optimize(a: &BenchArgs) -> Result<(), Error> {
             r.setup_seconds
         ));
     }
-    return emit(&t);
+    emit(&t)
 }
 
 /// `bench menzel-guthe MESH...`: applied collapses per second beside our QEM's.
@@ -230,7 +230,7 @@ fn menzel_guthe(a: &BenchArgs) -> Result<(), Error> {
             r.qem_collapses_per_second
         ));
     }
-    return emit(&t);
+    emit(&t)
 }
 
 /// `bench simplify MESH...`: every simplifier at each ratio.
@@ -273,7 +273,7 @@ fn simplify(a: &BenchArgs) -> Result<(), Error> {
             r.mean_relative
         ));
     }
-    return emit(&t);
+    emit(&t)
 }
 
 /// `bench raster`: the rasterizer on a large torus.

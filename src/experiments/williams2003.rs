@@ -244,147 +244,213 @@ pub fn run(config: &Path, log: &mut dyn FnMut(&str)) -> Result<Vec<SummaryRow>> 
     let rig = Rig::parse(&exp.rig).expect("checked");
     let (mut rows, mut summary, mut pre_rows) = (Vec::new(), Vec::new(), Vec::new());
     for spec in &exp.scene {
-        let shading = Shading::parse(&spec.shading).expect("checked");
-        let original = mesh::load(&base.join(&spec.mesh), &LoadOptions::default())?;
-        let start = Instant::now();
-        let w = Williams::build(&original)?;
-        pre_rows.push(PreprocessRow {
-            scene: spec.name.clone(),
-            triangles: original.triangle_count(),
-            nodes: w.hierarchy.node_count(),
-            mt_triangles: w.hierarchy.tris.len(),
-            seconds: start.elapsed().as_secs_f64(),
-        });
-        let cameras = rig.cameras(&original, 1.0);
-        let original = Arc::new(original);
-        let scene = RenderScene::of(original.clone());
-        let single = settings(exp.single_size, exp.samples, shading);
-        let mean = settings(exp.mean_size, exp.samples, shading);
-        let single_ref = scorer.prepare(linear(&raster::render(&scene, &cameras[0], &single)?)?);
-        let mut sheet = Vec::new();
-        let mut mean_refs = Vec::new();
-        for c in &cameras {
-            let frame = raster::render(&scene, c, &mean)?;
-            mean_refs.push(scorer.prepare(linear(&frame)?));
-            if sheet.is_empty() {
-                sheet.push(frame);
-            }
-        }
-        let n = original.triangle_count();
-        let smallest = exp.budgets.iter().copied().fold(1.0, f64::min);
-        for &criterion in &exp.criteria {
-            let opts = |size: u32| Options {
-                shading,
-                criterion,
-                size: (size, size),
-                ..Options::default()
-            };
-            let mut curve = Vec::new();
-            for &ratio in &exp.budgets {
-                let budget = ((n as f64 * ratio).round() as usize).max(1);
-                // View 0, as the paper plots it.
-                let mut cut = Cut::coarsest(&w.hierarchy);
-                w.adapt(&mut cut, &cameras[0], budget, &opts(exp.single_size));
-                let lod = w.mesh(&cut)?;
-                let triangles = lod.triangle_count();
-                let (flip, vdp, jnd, _) = score(&scorer, &single_ref, lod, &cameras[0], &single)?;
-                rows.push(Row {
-                    scene: spec.name.clone(),
-                    criterion: criterion.name().into(),
-                    budget,
-                    ratio,
-                    view: 0,
-                    size: exp.single_size,
-                    triangles,
-                    flip,
-                    vdp,
-                    vdp_jnd: jnd,
-                });
-                let (view0_flip, view0_jnd) = (flip, jnd);
-                // Every view along the rig's path, the cut carried over.
-                let mut cut = Cut::coarsest(&w.hierarchy);
-                let (mut sum_flip, mut sum_jnd) = (0.0, 0.0);
-                for (v, camera) in cameras.iter().enumerate() {
-                    if !exp.temporal_coherence {
-                        cut = Cut::coarsest(&w.hierarchy);
-                    }
-                    w.adapt(&mut cut, camera, budget, &opts(exp.mean_size));
-                    let lod = w.mesh(&cut)?;
-                    let triangles = lod.triangle_count();
-                    let (flip, vdp, jnd, frame) =
-                        score(&scorer, &mean_refs[v], lod, camera, &mean)?;
-                    if v == 0 && ratio == smallest {
-                        sheet.push(frame);
-                    }
-                    sum_flip += flip;
-                    sum_jnd += jnd;
-                    rows.push(Row {
-                        scene: spec.name.clone(),
-                        criterion: criterion.name().into(),
-                        budget,
-                        ratio,
-                        view: v,
-                        size: exp.mean_size,
-                        triangles,
-                        flip,
-                        vdp,
-                        vdp_jnd: jnd,
-                    });
-                }
-                let k = cameras.len() as f64;
-                let s = SummaryRow {
-                    scene: spec.name.clone(),
-                    criterion: criterion.name().into(),
-                    budget,
-                    ratio,
-                    view0_flip,
-                    view0_vdp_jnd: view0_jnd,
-                    mean_flip: crate::eval::tables::round7(sum_flip / k),
-                    mean_vdp_jnd: crate::eval::tables::round7(sum_jnd / k),
-                };
-                log(&format!(
-                    "{} {} budget {}: view 0 FLIP {:.4} JND {:.3}; mean FLIP {:.4} JND {:.3}",
-                    s.scene,
-                    s.criterion,
-                    budget,
-                    s.view0_flip,
-                    s.view0_vdp_jnd,
-                    s.mean_flip,
-                    s.mean_vdp_jnd
-                ));
-                curve.push(s.clone());
-                summary.push(s);
-            }
-        }
-        write_plots(&out, &spec.name, &summary)?;
-        // At most SHEET_SIZE pixels a side per image, so the sheets stay small enough to commit.
-        let images: Vec<image::RgbImage> = sheet
-            .iter()
-            .map(|f| {
-                let img = f.to_srgb8();
-                if img.width() > SHEET_SIZE {
-                    let h = img.height() * SHEET_SIZE / img.width();
-                    image::imageops::resize(
-                        &img,
-                        SHEET_SIZE,
-                        h,
-                        image::imageops::FilterType::Triangle,
-                    )
-                } else {
-                    img
-                }
-            })
-            .collect();
-        let sheet = crate::io::sheet::contact_sheet(&images, images.len() as u32, 4, [255; 3])?;
-        crate::io::write_image(
-            &out.join(format!("{}-sheet.png", spec.name)),
-            &image::DynamicImage::ImageRgb8(sheet),
-        )?;
+        let tables = Tables {
+            rows: &mut rows,
+            summary: &mut summary,
+            preprocess: &mut pre_rows,
+        };
+        let setting = Setting {
+            exp: &exp,
+            base,
+            out: &out,
+            scorer: &scorer,
+            rig: &rig,
+        };
+        run_scene(&setting, spec, tables, log)?;
     }
     crate::io::csv::write_rows(&out.join("results.csv"), None, &rows)?;
     crate::io::csv::write_rows(&out.join("summary.csv"), None, &summary)?;
     crate::io::csv::write_rows(&out.join("preprocess.csv"), None, &pre_rows)?;
     Ok(summary)
+}
+
+/// The tables the runs append to.
+struct Tables<'a> {
+    rows: &'a mut Vec<Row>,
+    summary: &'a mut Vec<SummaryRow>,
+    preprocess: &'a mut Vec<PreprocessRow>,
+}
+
+/// What every scene of a run shares.
+struct Setting<'a> {
+    exp: &'a Experiment,
+    base: &'a Path,
+    out: &'a Path,
+    scorer: &'a Scorer,
+    rig: &'a Rig,
+}
+
+/// One scene: preprocess, then every criterion at every budget, on view 0 and along the rig's
+/// path; its plots and contact sheet.
+fn run_scene(
+    setting: &Setting<'_>,
+    spec: &SceneSpec,
+    tables: Tables<'_>,
+    log: &mut dyn FnMut(&str),
+) -> Result<()> {
+    let Setting {
+        exp,
+        base,
+        out,
+        scorer,
+        rig,
+    } = *setting;
+    let Tables {
+        rows,
+        summary,
+        preprocess: pre_rows,
+    } = tables;
+    let shading = Shading::parse(&spec.shading).expect("checked");
+    let original = mesh::load(&base.join(&spec.mesh), &LoadOptions::default())?;
+    let start = Instant::now();
+    let w = Williams::build(&original)?;
+    pre_rows.push(PreprocessRow {
+        scene: spec.name.clone(),
+        triangles: original.triangle_count(),
+        nodes: w.hierarchy.node_count(),
+        mt_triangles: w.hierarchy.tris.len(),
+        seconds: start.elapsed().as_secs_f64(),
+    });
+    let cameras = rig.cameras(&original, 1.0);
+    let original = Arc::new(original);
+    let scene = RenderScene::of(original.clone());
+    let single = settings(exp.single_size, exp.samples, shading);
+    let mean = settings(exp.mean_size, exp.samples, shading);
+    let single_ref = scorer.prepare(linear(&raster::render(&scene, &cameras[0], &single)?)?);
+    let (mean_refs, first) = references(scorer, &scene, &cameras, &mean)?;
+    let mut sheet = vec![first];
+    let n = original.triangle_count();
+    let smallest = exp.budgets.iter().copied().fold(1.0, f64::min);
+    for &criterion in &exp.criteria {
+        let opts = |size: u32| Options {
+            shading,
+            criterion,
+            size: (size, size),
+            ..Options::default()
+        };
+        for &ratio in &exp.budgets {
+            let budget = ((n as f64 * ratio).round() as usize).max(1);
+            // View 0, as the paper plots it.
+            let mut cut = Cut::coarsest(&w.hierarchy);
+            w.adapt(&mut cut, &cameras[0], budget, &opts(exp.single_size));
+            let lod = w.mesh(&cut)?;
+            let triangles = lod.triangle_count();
+            let (flip, vdp, jnd, _) = score(scorer, &single_ref, lod, &cameras[0], &single)?;
+            rows.push(Row {
+                scene: spec.name.clone(),
+                criterion: criterion.name().into(),
+                budget,
+                ratio,
+                view: 0,
+                size: exp.single_size,
+                triangles,
+                flip,
+                vdp,
+                vdp_jnd: jnd,
+            });
+            let (view0_flip, view0_jnd) = (flip, jnd);
+            // Every view along the rig's path, the cut carried over.
+            let mut cut = Cut::coarsest(&w.hierarchy);
+            let (mut sum_flip, mut sum_jnd) = (0.0, 0.0);
+            for (v, camera) in cameras.iter().enumerate() {
+                if !exp.temporal_coherence {
+                    cut = Cut::coarsest(&w.hierarchy);
+                }
+                w.adapt(&mut cut, camera, budget, &opts(exp.mean_size));
+                let lod = w.mesh(&cut)?;
+                let triangles = lod.triangle_count();
+                let (flip, vdp, jnd, frame) = score(scorer, &mean_refs[v], lod, camera, &mean)?;
+                if v == 0 && ratio == smallest {
+                    sheet.push(frame);
+                }
+                sum_flip += flip;
+                sum_jnd += jnd;
+                rows.push(Row {
+                    scene: spec.name.clone(),
+                    criterion: criterion.name().into(),
+                    budget,
+                    ratio,
+                    view: v,
+                    size: exp.mean_size,
+                    triangles,
+                    flip,
+                    vdp,
+                    vdp_jnd: jnd,
+                });
+            }
+            let views = cameras.len() as f64;
+            let s = SummaryRow {
+                scene: spec.name.clone(),
+                criterion: criterion.name().into(),
+                budget,
+                ratio,
+                view0_flip,
+                view0_vdp_jnd: view0_jnd,
+                mean_flip: crate::eval::tables::round7(sum_flip / views),
+                mean_vdp_jnd: crate::eval::tables::round7(sum_jnd / views),
+            };
+            log(&s.describe());
+            summary.push(s);
+        }
+    }
+    write_plots(out, &spec.name, summary)?;
+    write_sheet(out, &spec.name, &sheet)
+}
+
+impl SummaryRow {
+    /// One line for the log.
+    fn describe(&self) -> String {
+        format!(
+            "{} {} budget {}: view 0 FLIP {:.4} JND {:.3}; mean FLIP {:.4} JND {:.3}",
+            self.scene,
+            self.criterion,
+            self.budget,
+            self.view0_flip,
+            self.view0_vdp_jnd,
+            self.mean_flip,
+            self.mean_vdp_jnd
+        )
+    }
+}
+
+/// The original's prepared render from every camera, and its first frame (the sheet's first).
+fn references(
+    scorer: &Scorer,
+    scene: &RenderScene,
+    cameras: &[crate::scene::Camera],
+    settings: &RenderSettings,
+) -> Result<(Vec<crate::eval::score::Reference>, crate::raster::Frame)> {
+    let mut first = None;
+    let mut refs = Vec::new();
+    for c in cameras {
+        let frame = raster::render(scene, c, settings)?;
+        refs.push(scorer.prepare(linear(&frame)?));
+        first.get_or_insert(frame);
+    }
+    let first = first.ok_or_else(|| Error::Internal("a rig without cameras".into()))?;
+    Ok((refs, first))
+}
+
+/// `SCENE-sheet.png`: the frames side by side, at most `SHEET_SIZE` pixels a side each, so the
+/// sheets stay small enough to commit.
+fn write_sheet(out: &Path, name: &str, sheet: &[crate::raster::Frame]) -> Result<()> {
+    let images: Vec<image::RgbImage> = sheet
+        .iter()
+        .map(|f| {
+            let img = f.to_srgb8();
+            if img.width() > SHEET_SIZE {
+                let h = img.height() * SHEET_SIZE / img.width();
+                image::imageops::resize(&img, SHEET_SIZE, h, image::imageops::FilterType::Triangle)
+            } else {
+                img
+            }
+        })
+        .collect();
+    let sheet = crate::io::sheet::contact_sheet(&images, images.len() as u32, 4, [255; 3])?;
+    crate::io::write_image(
+        &out.join(format!("{name}-sheet.png")),
+        &image::DynamicImage::ImageRgb8(sheet),
+    )
 }
 
 /// `SCENE.svg` and `SCENE.png`: four panels stacked — view-0 FLIP, view-0 VDP JND, mean FLIP, mean VDP JND —
