@@ -270,25 +270,7 @@ pub fn remesh(mesh: &Arc<Mesh>, options: &Options) -> Result<Remesh> {
     let mut seconds = Seconds::default();
     let t = Instant::now();
     let ts = texture_space(&RenderScene::of(mesh.clone()), options.map_size)?;
-    if ts.overlapping * 200 > ts.covered {
-        return Err(Error::input(
-            &mesh.source().path,
-            format!(
-                "{:.1} % of the UV layout is covered by more than one triangle (overlapping or \
-                 mirrored charts), so texels do not map to one point of the surface",
-                100.0 * ts.overlapping as f64 / ts.covered.max(1) as f64
-            ),
-            "qu-meyer needs a one-to-one UV layout: unwrap the mesh without overlaps, or give \
-             mirrored parts their own space in the atlas",
-        ));
-    }
-    if options.vertices > ts.covered {
-        return Err(Error::Usage(format!(
-            "--vertices {}: more than the {} texels the UV layout covers at --map-size {}; ask \
-             for fewer vertices or a larger map",
-            options.vertices, ts.covered, options.map_size
-        )));
-    }
+    check_layout(mesh, &ts, options)?;
     let charts = Charts::of(mesh);
     let maps = Maps::new(mesh, &ts, &charts);
     seconds.maps = t.elapsed().as_secs_f64();
@@ -344,35 +326,17 @@ pub fn remesh(mesh: &Arc<Mesh>, options: &Options) -> Result<Remesh> {
     seconds.sampling = t.elapsed().as_secs_f64();
 
     let t = Instant::now();
-    let weights: Vec<f32> = density.domain.iter().map(|&d| d * d).collect();
-    let mut texels: Vec<Vec<u32>> = vec![Vec::new(); charts.count];
-    for (i, &c) in maps.chart.iter().enumerate() {
-        if c != u32::MAX {
-            texels[c as usize].push(i as u32);
-        }
-    }
-    for (c, samples) in free.iter_mut().enumerate() {
-        let fixed = fixed_sites(mesh, &ts, &charts, &keep, c);
-        let chart = &maps.chart;
-        let size = ts.size;
-        let in_chart = |p: Vec2| {
-            let (x, y) = (p.x.floor(), p.y.floor());
-            x >= 0.0
-                && y >= 0.0
-                && (x as usize) < size
-                && (y as usize) < size
-                && chart[y as usize * size + x as usize] == c as u32
-        };
-        lloyd::relax(
-            ts.size,
-            &texels[c],
-            &weights,
-            &in_chart,
-            &fixed,
-            samples,
-            options.lloyd_iterations,
-        );
-    }
+    let fixed: Vec<Vec<Vec2>> = (0..charts.count)
+        .map(|c| fixed_sites(mesh, &ts, &charts, &keep, c))
+        .collect();
+    relax(
+        &ts,
+        &maps,
+        &density,
+        &fixed,
+        &mut free,
+        options.lloyd_iterations,
+    );
     seconds.lloyd = t.elapsed().as_secs_f64();
 
     let t = Instant::now();
@@ -405,6 +369,65 @@ pub fn remesh(mesh: &Arc<Mesh>, options: &Options) -> Result<Remesh> {
         maps: images,
         mesh: out,
     })
+}
+
+/// The UV layout can carry the remesh: one-to-one (at most 0.5 % of it covered twice), and
+/// with a texel for every vertex asked for.
+fn check_layout(mesh: &Mesh, ts: &TextureSpace, options: &Options) -> Result<()> {
+    if ts.overlapping * 200 > ts.covered {
+        return Err(Error::input(
+            &mesh.source().path,
+            format!(
+                "{:.1} % of the UV layout is covered by more than one triangle (overlapping or \
+                 mirrored charts), so texels do not map to one point of the surface",
+                100.0 * ts.overlapping as f64 / ts.covered.max(1) as f64
+            ),
+            "qu-meyer needs a one-to-one UV layout: unwrap the mesh without overlaps, or give \
+             mirrored parts their own space in the atlas",
+        ));
+    }
+    if options.vertices > ts.covered {
+        return Err(Error::Usage(format!(
+            "--vertices {}: more than the {} texels the UV layout covers at --map-size {}; ask \
+             for fewer vertices or a larger map",
+            options.vertices, ts.covered, options.map_size
+        )));
+    }
+    Ok(())
+}
+
+/// Lloyd relaxation of each chart's free samples, weighted by the squared density, around the
+/// chart's `fixed` boundary sites.
+fn relax(
+    ts: &TextureSpace,
+    maps: &Maps,
+    density: &Density,
+    fixed: &[Vec<Vec2>],
+    free: &mut [Vec<Vec2>],
+    iterations: usize,
+) {
+    let weights: Vec<f32> = density.domain.iter().map(|&d| d * d).collect();
+    let mut texels: Vec<Vec<u32>> = vec![Vec::new(); fixed.len()];
+    for (i, &c) in maps.chart.iter().enumerate() {
+        if c != u32::MAX {
+            texels[c as usize].push(i as u32);
+        }
+    }
+    for (c, samples) in free.iter_mut().enumerate() {
+        let chart = &maps.chart;
+        let size = ts.size;
+        let in_chart = |p: Vec2| {
+            let (x, y) = (p.x.floor(), p.y.floor());
+            x >= 0.0
+                && y >= 0.0
+                && (x as usize) < size
+                && (y as usize) < size
+                && chart[y as usize * size + x as usize] == c as u32
+        };
+        lloyd::relax(
+            ts.size, &texels[c], &weights, &in_chart, &fixed[c], samples, iterations,
+        );
+    }
 }
 
 /// Position per welded vertex.

@@ -216,64 +216,9 @@ pub fn triangulate(
             }
             insert(&mut cdt, uv, Origin::Free(uv)).map_err(Err)?;
         }
-        // Emit the faces inside the chart: crossing a constraint edge toggles between outside
-        // and inside, starting outside at the convex hull (exact, where a test of a thin
-        // sliver's centroid against the polygon is not).
-        let mut parity: Vec<Option<bool>> = vec![None; cdt.num_all_faces()];
-        let mut queue = std::collections::VecDeque::new();
-        for face in cdt.inner_faces() {
-            for e in face.adjacent_edges() {
-                if e.rev().face().is_outer() && parity[face.fix().index()].is_none() {
-                    parity[face.fix().index()] = Some(e.is_constraint_edge());
-                    queue.push_back(face.fix());
-                }
-            }
-        }
-        while let Some(f) = queue.pop_front() {
-            let here = parity[f.index()].unwrap_or(false);
-            for e in cdt.face(f).adjacent_edges() {
-                if let Some(n) = e.rev().face().as_inner()
-                    && parity[n.fix().index()].is_none()
-                {
-                    parity[n.fix().index()] = Some(here ^ e.is_constraint_edge());
-                    queue.push_back(n.fix());
-                }
-            }
-        }
-        let mut index: Vec<u32> = vec![u32::MAX; origin.len()];
+        let parity = inside_faces(&cdt);
         let flip = winding[c] < 0.0;
-        for face in cdt.inner_faces() {
-            if parity[face.fix().index()] != Some(true) {
-                continue;
-            }
-            let vs = face.vertices();
-            let pts = vs.map(|v| {
-                let p = v.position();
-                Vec2::new(p.x as f32, p.y as f32)
-            });
-            let centroid = (pts[0] + pts[1] + pts[2]) / 3.0;
-            let mut tri = [0u32; 3];
-            for (k, v) in vs.iter().enumerate() {
-                let h = v.fix().index();
-                if index[h] == u32::MAX {
-                    let Some(o) = origin[h] else {
-                        return Err(Err(Error::Internal(
-                            "qu-meyer: a triangulation vertex without an origin".into(),
-                        )));
-                    };
-                    index[h] = out.push_vertex(mesh, &locator, c as u32, o);
-                }
-                tri[k] = index[h];
-            }
-            if flip {
-                tri.swap(1, 2);
-            }
-            let material = locator
-                .locate(c as u32, centroid)
-                .map_or(0, |(t, _)| mesh.material_ids()[t as usize]);
-            out.triangles.push(tri);
-            out.material_ids.push(material);
-        }
+        emit_faces(&cdt, &parity, &origin, flip, c as u32, &locator, &mut out).map_err(Err)?;
     }
     if !refine.is_empty() {
         refine.sort_unstable();
@@ -281,6 +226,81 @@ pub fn triangulate(
         return Err(Ok(refine));
     }
     Ok(out)
+}
+
+/// Which faces of `cdt` are inside the chart: crossing a constraint edge toggles between outside
+/// and inside, starting outside at the convex hull (exact, where a test of a thin sliver's
+/// centroid against the polygon is not).
+fn inside_faces(cdt: &ConstrainedDelaunayTriangulation<Point2<f64>>) -> Vec<Option<bool>> {
+    let mut parity: Vec<Option<bool>> = vec![None; cdt.num_all_faces()];
+    let mut queue = std::collections::VecDeque::new();
+    for face in cdt.inner_faces() {
+        for e in face.adjacent_edges() {
+            if e.rev().face().is_outer() && parity[face.fix().index()].is_none() {
+                parity[face.fix().index()] = Some(e.is_constraint_edge());
+                queue.push_back(face.fix());
+            }
+        }
+    }
+    while let Some(f) = queue.pop_front() {
+        let here = parity[f.index()].unwrap_or(false);
+        for e in cdt.face(f).adjacent_edges() {
+            if let Some(n) = e.rev().face().as_inner()
+                && parity[n.fix().index()].is_none()
+            {
+                parity[n.fix().index()] = Some(here ^ e.is_constraint_edge());
+                queue.push_back(n.fix());
+            }
+        }
+    }
+    parity
+}
+
+/// Append the faces inside chart `chart` to `out`, each vertex once, wound as the chart is in
+/// UV (`flip`), each triangle with the material found at its centroid.
+fn emit_faces(
+    cdt: &ConstrainedDelaunayTriangulation<Point2<f64>>,
+    parity: &[Option<bool>],
+    origin: &[Option<Origin>],
+    flip: bool,
+    chart: u32,
+    locator: &Locator<'_>,
+    out: &mut Built,
+) -> Result<()> {
+    let mut index: Vec<u32> = vec![u32::MAX; origin.len()];
+    for face in cdt.inner_faces() {
+        if parity[face.fix().index()] != Some(true) {
+            continue;
+        }
+        let vs = face.vertices();
+        let pts = vs.map(|v| {
+            let p = v.position();
+            Vec2::new(p.x as f32, p.y as f32)
+        });
+        let centroid = (pts[0] + pts[1] + pts[2]) / 3.0;
+        let mut tri = [0u32; 3];
+        for (k, v) in vs.iter().enumerate() {
+            let h = v.fix().index();
+            if index[h] == u32::MAX {
+                let Some(o) = origin[h] else {
+                    return Err(Error::Internal(
+                        "qu-meyer: a triangulation vertex without an origin".into(),
+                    ));
+                };
+                index[h] = out.push_vertex(locator.mesh, locator, chart, o);
+            }
+            tri[k] = index[h];
+        }
+        if flip {
+            tri.swap(1, 2);
+        }
+        let material = locator
+            .locate(chart, centroid)
+            .map_or(0, |(t, _)| locator.mesh.material_ids()[t as usize]);
+        out.triangles.push(tri);
+        out.material_ids.push(material);
+    }
+    Ok(())
 }
 
 impl Built {
