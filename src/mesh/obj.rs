@@ -141,43 +141,8 @@ fn scan(path: &Path, text: &str) -> Result<Scan> {
         let keep = match tokens.next() {
             Some("v") => {
                 floats(path, line_no, &mut tokens, 3, "vertex")?;
-                // After x y z: nothing, a weight w (x y z are divided by it), or an RGB colour.
-                let rest: Vec<&str> = tokens.collect();
-                match rest.len() {
-                    0 => {}
-                    1 if rest[0]
-                        .parse::<f32>()
-                        .map_or(true, |w| w == 0.0 || !w.is_finite()) =>
-                    {
-                        return Err(Error::input_at(
-                            path,
-                            Location::Line(line_no),
-                            format!("vertex weight w = '{}' must be a non-zero number", rest[0]),
-                            FIX_SYNTAX,
-                        ));
-                    }
-                    1 => {}
-                    3 => {
-                        floats(
-                            path,
-                            line_no,
-                            &mut line.split_whitespace().skip(4),
-                            3,
-                            "vertex colour",
-                        )?;
-                        colored += 1;
-                    }
-                    n => {
-                        return Err(Error::input_at(
-                            path,
-                            Location::Line(line_no),
-                            format!(
-                                "vertex record has {} numbers; expected 3 (x y z), 4 (x y z w) or 6 (x y z r g b)",
-                                n + 3
-                            ),
-                            FIX_SYNTAX,
-                        ));
-                    }
+                if vertex_extras(path, line_no, line, tokens)? {
+                    colored += 1;
                 }
                 counts[0] += 1;
                 referenced.push(false);
@@ -239,18 +204,7 @@ fn scan(path: &Path, text: &str) -> Result<Scan> {
     // tobj needs colours on every vertex or none; with only some, drop them all (and say so).
     let partial_colors = colored > 0 && colored < counts[0];
     if partial_colors {
-        body = body
-            .split('\n')
-            .map(|l| {
-                let t: Vec<&str> = l.split_whitespace().collect();
-                if t.first() == Some(&"v") && t.len() == 7 {
-                    t[..4].join(" ")
-                } else {
-                    l.to_string()
-                }
-            })
-            .collect::<Vec<_>>()
-            .join("\n");
+        body = without_colors(&body);
     }
     let mut text = String::with_capacity(body.len() + 64);
     for (_, name) in &mtllibs {
@@ -268,6 +222,69 @@ fn scan(path: &Path, text: &str) -> Result<Scan> {
         usemtls,
         text,
     })
+}
+
+/// What follows a vertex record's x y z: nothing, a weight w (x y z are divided by it), or an
+/// RGB colour (`true`).
+fn vertex_extras<'a>(
+    path: &Path,
+    line_no: usize,
+    line: &str,
+    tokens: impl Iterator<Item = &'a str>,
+) -> Result<bool> {
+    let rest: Vec<&str> = tokens.collect();
+    match rest.len() {
+        0 => {}
+        1 if rest[0]
+            .parse::<f32>()
+            .map_or(true, |w| w == 0.0 || !w.is_finite()) =>
+        {
+            return Err(Error::input_at(
+                path,
+                Location::Line(line_no),
+                format!("vertex weight w = '{}' must be a non-zero number", rest[0]),
+                FIX_SYNTAX,
+            ));
+        }
+        1 => {}
+        3 => {
+            floats(
+                path,
+                line_no,
+                &mut line.split_whitespace().skip(4),
+                3,
+                "vertex colour",
+            )?;
+        }
+        n => {
+            return Err(Error::input_at(
+                path,
+                Location::Line(line_no),
+                format!(
+                    "vertex record has {} numbers; expected 3 (x y z), 4 (x y z w) or 6 (x y z r g b)",
+                    n + 3
+                ),
+                FIX_SYNTAX,
+            ));
+        }
+    }
+    Ok(rest.len() == 3)
+}
+
+/// `body` with the colours dropped from every vertex record (tobj needs colours on every vertex
+/// or none).
+fn without_colors(body: &str) -> String {
+    body.split('\n')
+        .map(|l| {
+            let t: Vec<&str> = l.split_whitespace().collect();
+            if t.first() == Some(&"v") && t.len() == 7 {
+                t[..4].join(" ")
+            } else {
+                l.to_string()
+            }
+        })
+        .collect::<Vec<_>>()
+        .join("\n")
 }
 
 /// The file's text: UTF-8 without a leading byte-order mark (which would glue itself to the first

@@ -123,27 +123,7 @@ pub fn texture_space(scene: &RenderScene, size: usize) -> Result<TextureSpace> {
     let half = texel * size as f32 * 0.5;
     let origin = Vec2::new(centre.x - half, centre.y + half);
 
-    // The UV layout as a flat mesh in the plane z = 0, centred, seen from +z.
-    let flat = flat_layout(mesh, centre)?;
-    let camera = Camera {
-        eye: Vec3::Z,
-        target: Vec3::ZERO,
-        up: Vec3::Y,
-        projection: Projection::Orthographic { half_height: half },
-        near: 0.5,
-        far: 1.5,
-    };
-    let settings = RenderSettings {
-        width: side,
-        height: side,
-        samples: SamplePattern::Ordered(1),
-        shading: Shading::Unlit,
-        ..RenderSettings::DEFAULT
-    };
-    let flat_scene = RenderScene::of(Arc::new(flat));
-    let frame = super::render(&flat_scene, &camera, &settings)?;
-    let counts = super::coverage_counts(&flat_scene, &camera, &settings)?;
-    let overlapping = counts.iter().filter(|&&c| c > 1).count();
+    let (frame, overlapping) = render_layout(mesh, centre, half, side)?;
 
     let ids = frame.triangle_ids().to_vec();
     let covered = ids.iter().filter(|&&t| t != NO_TRIANGLE).count();
@@ -192,19 +172,7 @@ pub fn texture_space(scene: &RenderScene, size: usize) -> Result<TextureSpace> {
                 let lerp = |a: &[Vec3]| a[tri[0]] * b.x + a[tri[1]] * b.y + a[tri[2]] * b.z;
                 let p = lerp(mesh.positions());
                 let normal = lerp(mesh.normals()).normalize_or(Vec3::Z);
-                // Seen head-on: the viewer looks along the normal.
-                let viewer = Camera {
-                    eye: p + normal,
-                    target: p,
-                    up: if normal.y.abs() < 0.99 {
-                        Vec3::Y
-                    } else {
-                        Vec3::Z
-                    },
-                    projection: Projection::Orthographic { half_height: 1.0 },
-                    near: 0.5,
-                    far: 1.5,
-                };
+                let viewer = head_on(p, normal);
                 resolved.clear();
                 resolved.extend(
                     lights
@@ -235,6 +203,54 @@ pub fn texture_space(scene: &RenderScene, size: usize) -> Result<TextureSpace> {
             }
         });
     Ok(out)
+}
+
+/// The UV layout as a flat mesh in the plane z = 0, centred, seen from +z on a `side`² frame
+/// `2·half` wide: its frame (triangle ids per texel) and the number of texels more than one
+/// triangle covers.
+fn render_layout(
+    mesh: &crate::mesh::Mesh,
+    centre: Vec2,
+    half: f32,
+    side: u32,
+) -> Result<(super::Frame, usize)> {
+    let flat = flat_layout(mesh, centre)?;
+    let camera = Camera {
+        eye: Vec3::Z,
+        target: Vec3::ZERO,
+        up: Vec3::Y,
+        projection: Projection::Orthographic { half_height: half },
+        near: 0.5,
+        far: 1.5,
+    };
+    let settings = RenderSettings {
+        width: side,
+        height: side,
+        samples: SamplePattern::Ordered(1),
+        shading: Shading::Unlit,
+        ..RenderSettings::DEFAULT
+    };
+    let flat_scene = RenderScene::of(Arc::new(flat));
+    let frame = super::render(&flat_scene, &camera, &settings)?;
+    let counts = super::coverage_counts(&flat_scene, &camera, &settings)?;
+    let overlapping = counts.iter().filter(|&&c| c > 1).count();
+    Ok((frame, overlapping))
+}
+
+/// A camera that sees the surface point `p` head-on: looking along `normal`.
+fn head_on(p: Vec3, normal: Vec3) -> Camera {
+    Camera {
+        eye: p + normal,
+        target: p,
+        up: if normal.y.abs() < 0.99 {
+            Vec3::Y
+        } else {
+            Vec3::Z
+        },
+        projection: Projection::Orthographic { half_height: 1.0 },
+        near: 0.5,
+        far: 1.5,
+    }
 }
 
 /// `mesh`'s UV layout as a mesh in the plane z = 0, centred on `centre`, the same triangles in

@@ -382,42 +382,7 @@ fn add_mesh(
             }
             Ok(())
         };
-        match reader.read_normals() {
-            Some(n) => {
-                let n: Vec<Option<Vec3>> = n.map(|n| Some(normal_matrix * Vec3::from(n))).collect();
-                attr_len(n.len(), "NORMAL")?;
-                b.normals.extend(n);
-            }
-            None => {
-                b.any_without_normals = true;
-                b.normals.extend(std::iter::repeat_n(None, count));
-            }
-        }
-        for (set, out) in [(0, &mut b.uvs), (1, &mut b.uvs1)] {
-            match reader.read_tex_coords(set) {
-                Some(t) => {
-                    // glTF puts v = 0 at the top of the image; lodeval uses the OpenGL
-                    // convention (bottom).
-                    let t: Vec<Option<Vec2>> = t
-                        .into_f32()
-                        .map(|t| Some(Vec2::new(t[0], 1.0 - t[1])))
-                        .collect();
-                    attr_len(t.len(), &format!("TEXCOORD_{set}"))?;
-                    out.extend(t);
-                }
-                None => out.extend(std::iter::repeat_n(None, count)),
-            }
-        }
-        match reader.read_colors(0) {
-            Some(c) => {
-                let c: Vec<[f32; 4]> = c.into_rgba_f32().collect();
-                attr_len(c.len(), "COLOR_0")?;
-                b.color_alpha |= c.iter().any(|c| c[3] < 1.0);
-                b.colors
-                    .extend(c.iter().map(|c| Some(Vec3::new(c[0], c[1], c[2]))));
-            }
-            None => b.colors.extend(std::iter::repeat_n(None, count)),
-        }
+        read_attributes(b, &reader, normal_matrix, count, &attr_len)?;
         let indices: Vec<u32> = match reader.read_indices() {
             Some(i) => i.into_u32().collect(),
             None => (0..count as u32).collect(),
@@ -430,21 +395,7 @@ fn add_mesh(
                 REEXPORT,
             ));
         }
-        let tris: Vec<[u32; 3]> = match prim.mode() {
-            Mode::Triangles => indices
-                .chunks_exact(3)
-                .map(|c| [c[0], c[1], c[2]])
-                .collect(),
-            Mode::TriangleStrip => (0..indices.len().saturating_sub(2))
-                .map(|k| {
-                    let (a, bb, c) = (indices[k], indices[k + 1], indices[k + 2]);
-                    if k % 2 == 0 { [a, bb, c] } else { [bb, a, c] }
-                })
-                .collect(),
-            _ => (1..indices.len().saturating_sub(1))
-                .map(|k| [indices[0], indices[k], indices[k + 1]])
-                .collect(),
-        };
+        let tris = triangles_of(prim.mode(), &indices);
         let material = prim
             .material()
             .index()
@@ -457,4 +408,76 @@ fn add_mesh(
         }
     }
     Ok(())
+}
+
+/// A primitive's NORMAL, TEXCOORD_0/1 and COLOR_0 appended to `b` (placeholders where it has
+/// none); `check(len, name)` refuses an attribute whose length is not the positions' `count`.
+fn read_attributes<'a, 's, F>(
+    b: &mut Builder,
+    reader: &gltf::mesh::Reader<'a, 's, F>,
+    normal_matrix: Mat3,
+    count: usize,
+    check: &dyn Fn(usize, &str) -> Result<()>,
+) -> Result<()>
+where
+    F: Clone + Fn(gltf::Buffer<'a>) -> Option<&'s [u8]>,
+{
+    match reader.read_normals() {
+        Some(n) => {
+            let n: Vec<Option<Vec3>> = n.map(|n| Some(normal_matrix * Vec3::from(n))).collect();
+            check(n.len(), "NORMAL")?;
+            b.normals.extend(n);
+        }
+        None => {
+            b.any_without_normals = true;
+            b.normals.extend(std::iter::repeat_n(None, count));
+        }
+    }
+    for (set, out) in [(0, &mut b.uvs), (1, &mut b.uvs1)] {
+        match reader.read_tex_coords(set) {
+            Some(t) => {
+                // glTF puts v = 0 at the top of the image; lodeval uses the OpenGL
+                // convention (bottom).
+                let t: Vec<Option<Vec2>> = t
+                    .into_f32()
+                    .map(|t| Some(Vec2::new(t[0], 1.0 - t[1])))
+                    .collect();
+                check(t.len(), &format!("TEXCOORD_{set}"))?;
+                out.extend(t);
+            }
+            None => out.extend(std::iter::repeat_n(None, count)),
+        }
+    }
+    match reader.read_colors(0) {
+        Some(c) => {
+            let c: Vec<[f32; 4]> = c.into_rgba_f32().collect();
+            check(c.len(), "COLOR_0")?;
+            b.color_alpha |= c.iter().any(|c| c[3] < 1.0);
+            b.colors
+                .extend(c.iter().map(|c| Some(Vec3::new(c[0], c[1], c[2]))));
+        }
+        None => b.colors.extend(std::iter::repeat_n(None, count)),
+    }
+    Ok(())
+}
+
+/// Triangles from a primitive's indices: lists, strips (every other one flipped to keep the
+/// winding) or fans.
+fn triangles_of(mode: gltf::mesh::Mode, indices: &[u32]) -> Vec<[u32; 3]> {
+    use gltf::mesh::Mode;
+    match mode {
+        Mode::Triangles => indices
+            .chunks_exact(3)
+            .map(|c| [c[0], c[1], c[2]])
+            .collect(),
+        Mode::TriangleStrip => (0..indices.len().saturating_sub(2))
+            .map(|k| {
+                let (a, bb, c) = (indices[k], indices[k + 1], indices[k + 2]);
+                if k % 2 == 0 { [a, bb, c] } else { [bb, a, c] }
+            })
+            .collect(),
+        _ => (1..indices.len().saturating_sub(1))
+            .map(|k| [indices[0], indices[k], indices[k + 1]])
+            .collect(),
+    }
 }
