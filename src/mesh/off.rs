@@ -85,37 +85,10 @@ pub(crate) fn load(path: &Path) -> Result<MeshData> {
         let (line, t) = it
             .next()
             .ok_or_else(|| truncated(&format!("vertex {i} of {nv}")))?;
-        let need = 3 + if has_n { 3 } else { 0 } + if has_c { 3 } else { 0 };
-        if t.len() < need {
-            return Err(Error::input_at(
-                path,
-                Location::Line(line),
-                format!("vertex {i} has {} numbers; it needs {need}", t.len()),
-                FIX,
-            ));
-        }
-        let f = |k: usize| num::<f32>(path, line, t[k], "number");
-        let p = Vec3::new(f(0)?, f(1)?, f(2)?);
-        if !p.is_finite() {
-            return Err(Error::input_at(
-                path,
-                Location::Line(line),
-                format!("vertex {i} has a non-finite coordinate"),
-                FIX,
-            ));
-        }
+        let (p, n, c) = vertex(path, line, &t, i, (has_n, has_c))?;
         positions.push(p);
-        let mut k = 3;
-        if has_n {
-            normals.push(Vec3::new(f(k)?, f(k + 1)?, f(k + 2)?));
-            k += 3;
-        }
-        if has_c {
-            let c = Vec3::new(f(k)?, f(k + 1)?, f(k + 2)?);
-            // Integer colours are 0..255, float colours 0..1; both sRGB.
-            let c = if t[k].contains('.') { c } else { c / 255.0 };
-            colors.push(c.to_array().map(srgb_to_linear).into());
-        }
+        normals.extend(n);
+        colors.extend(c);
     }
 
     // Faces, one polygon per line.
@@ -124,28 +97,8 @@ pub(crate) fn load(path: &Path) -> Result<MeshData> {
         let (line, t) = it
             .next()
             .ok_or_else(|| truncated(&format!("face {i} of {nf}")))?;
-        let k: usize = num(path, line, t[0], "corner count")?;
-        if k < 3 || t.len() < k + 1 {
-            return Err(Error::input_at(
-                path,
-                Location::Line(line),
-                format!("face {i} must list at least 3 vertex indices after its count ({k})"),
-                FIX,
-            ));
-        }
-        let mut idx = Vec::with_capacity(k);
-        for tok in &t[1..=k] {
-            let v: usize = num(path, line, tok, "vertex index")?;
-            if v >= nv {
-                return Err(Error::input_at(
-                    path,
-                    Location::Line(line),
-                    format!("vertex index {v} is out of range (the file has {nv} vertices)"),
-                    FIX,
-                ));
-            }
-            idx.push(v as u32);
-        }
+        let idx = face(path, line, &t, i, nv)?;
+        let k = idx.len();
         for j in 1..k - 1 {
             triangles.push([idx[0], idx[j], idx[j + 1]]);
         }
@@ -173,4 +126,74 @@ pub(crate) fn load(path: &Path) -> Result<MeshData> {
         },
         warnings: vec![],
     })
+}
+
+/// Vertex `i`'s record on `line`: its position and, where the header says so (`has`: normals,
+/// colours), its normal and its colour (integers 0..255 or floats 0..1, both sRGB).
+fn vertex(
+    path: &Path,
+    line: usize,
+    t: &[&str],
+    i: usize,
+    (has_n, has_c): (bool, bool),
+) -> Result<(Vec3, Option<Vec3>, Option<Vec3>)> {
+    let need = 3 + if has_n { 3 } else { 0 } + if has_c { 3 } else { 0 };
+    if t.len() < need {
+        return Err(Error::input_at(
+            path,
+            Location::Line(line),
+            format!("vertex {i} has {} numbers; it needs {need}", t.len()),
+            FIX,
+        ));
+    }
+    let f = |k: usize| num::<f32>(path, line, t[k], "number");
+    let p = Vec3::new(f(0)?, f(1)?, f(2)?);
+    if !p.is_finite() {
+        return Err(Error::input_at(
+            path,
+            Location::Line(line),
+            format!("vertex {i} has a non-finite coordinate"),
+            FIX,
+        ));
+    }
+    let (mut normal, mut color) = (None, None);
+    let mut k = 3;
+    if has_n {
+        normal = Some(Vec3::new(f(k)?, f(k + 1)?, f(k + 2)?));
+        k += 3;
+    }
+    if has_c {
+        let c = Vec3::new(f(k)?, f(k + 1)?, f(k + 2)?);
+        // Integer colours are 0..255, float colours 0..1; both sRGB.
+        let c = if t[k].contains('.') { c } else { c / 255.0 };
+        color = Some(c.to_array().map(srgb_to_linear).into());
+    }
+    Ok((p, normal, color))
+}
+
+/// Face `i`'s record on `line`: its vertex indices, each below `nv`.
+fn face(path: &Path, line: usize, t: &[&str], i: usize, nv: usize) -> Result<Vec<u32>> {
+    let k: usize = num(path, line, t[0], "corner count")?;
+    if k < 3 || t.len() < k + 1 {
+        return Err(Error::input_at(
+            path,
+            Location::Line(line),
+            format!("face {i} must list at least 3 vertex indices after its count ({k})"),
+            FIX,
+        ));
+    }
+    let mut idx = Vec::with_capacity(k);
+    for tok in &t[1..=k] {
+        let v: usize = num(path, line, tok, "vertex index")?;
+        if v >= nv {
+            return Err(Error::input_at(
+                path,
+                Location::Line(line),
+                format!("vertex index {v} is out of range (the file has {nv} vertices)"),
+                FIX,
+            ));
+        }
+        idx.push(v as u32);
+    }
+    Ok(idx)
 }

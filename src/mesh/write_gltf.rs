@@ -337,25 +337,7 @@ fn node_warnings(mesh: &Mesh, shared: &Option<(String, Mat4)>) -> Vec<String> {
 /// `.gltf`), linked by `MSFT_lod`, with `coverage` (one value per level, non-increasing, the last
 /// usually 0) as `MSFT_screencoverage`. Returns every file written and what could not be kept.
 pub fn write_lod_chain(levels: &[(&str, &Mesh)], coverage: &[f64], path: &Path) -> Result<Written> {
-    let ext = path.extension().and_then(|e| e.to_str()).unwrap_or("");
-    if ext != "glb" && ext != "gltf" {
-        return Err(Error::Usage(format!(
-            "{}: a glTF LOD chain is written as .glb or .gltf",
-            path.display()
-        )));
-    }
-    if levels.is_empty() || coverage.len() != levels.len() {
-        return Err(Error::Internal(format!(
-            "glTF export: {} levels and {} coverage values",
-            levels.len(),
-            coverage.len()
-        )));
-    }
-    if coverage.iter().any(|c| !c.is_finite()) || coverage.windows(2).any(|w| w[1] > w[0]) {
-        return Err(Error::Internal(format!(
-            "glTF export: screen coverage {coverage:?} must be finite and non-increasing"
-        )));
-    }
+    let ext = check_chain(levels, coverage, path)?;
     // The finest level's node: its name and transform where every merged node shared one.
     let finest = levels[0].1;
     let shared = shared_transform(finest);
@@ -453,18 +435,7 @@ pub fn write_lod_chain(levels: &[(&str, &Mesh)], coverage: &[f64], path: &Path) 
         written.push(file.clone());
     }
     if ext == "glb" {
-        let glb = gltf::binary::Glb {
-            header: gltf::binary::Header {
-                magic: *b"glTF",
-                version: 2,
-                length: 0,
-            },
-            json: Cow::Owned(text),
-            bin: Some(Cow::Owned(buffer.bytes)),
-        };
-        let bytes = glb
-            .to_vec()
-            .map_err(|e| Error::Internal(format!("glTF export: GLB: {e}")))?;
+        let bytes = glb(text, buffer.bytes)?;
         staged.write(path, &bytes)?;
     } else {
         staged.write(path, &text)?;
@@ -476,4 +447,44 @@ pub fn write_lod_chain(levels: &[(&str, &Mesh)], coverage: &[f64], path: &Path) 
         files: written,
         warnings,
     })
+}
+
+/// The chain can be written: a `.glb` or `.gltf` path (its extension returned), one coverage
+/// value per level, finite and non-increasing.
+fn check_chain<'p>(levels: &[(&str, &Mesh)], coverage: &[f64], path: &'p Path) -> Result<&'p str> {
+    let ext = path.extension().and_then(|e| e.to_str()).unwrap_or("");
+    if ext != "glb" && ext != "gltf" {
+        return Err(Error::Usage(format!(
+            "{}: a glTF LOD chain is written as .glb or .gltf",
+            path.display()
+        )));
+    }
+    if levels.is_empty() || coverage.len() != levels.len() {
+        return Err(Error::Internal(format!(
+            "glTF export: {} levels and {} coverage values",
+            levels.len(),
+            coverage.len()
+        )));
+    }
+    if coverage.iter().any(|c| !c.is_finite()) || coverage.windows(2).any(|w| w[1] > w[0]) {
+        return Err(Error::Internal(format!(
+            "glTF export: screen coverage {coverage:?} must be finite and non-increasing"
+        )));
+    }
+    Ok(ext)
+}
+
+/// A binary glTF of the JSON document `json` and the buffer `bin`.
+fn glb(json: Vec<u8>, bin: Vec<u8>) -> Result<Vec<u8>> {
+    let glb = gltf::binary::Glb {
+        header: gltf::binary::Header {
+            magic: *b"glTF",
+            version: 2,
+            length: 0,
+        },
+        json: Cow::Owned(json),
+        bin: Some(Cow::Owned(bin)),
+    };
+    glb.to_vec()
+        .map_err(|e| Error::Internal(format!("glTF export: GLB: {e}")))
 }
