@@ -148,15 +148,6 @@ pub fn run(config: &Path, log: &mut dyn FnMut(&str)) -> Result<Report> {
             "give an `out` folder you can write to",
         )
     })?;
-    struct Made {
-        model: String,
-        budget: usize,
-        label: &'static str,
-        vertices: usize,
-        triangles: usize,
-        masked_share: f64,
-        seconds: f64,
-    }
     let mut made: Vec<Made> = Vec::new();
     let mut assets: Vec<AssetConfig> = Vec::new();
     let named = |e: String| {
@@ -236,9 +227,26 @@ pub fn run(config: &Path, log: &mut dyn FnMut(&str)) -> Result<Report> {
         &crate::eval::RunOptions::DEFAULT,
         &crate::progress::Silent,
     )?;
-    let mean = |a: &str, l: &str, metric: Metric| outcome.results.mean(a, l, metric).unwrap_or(0.0);
-    let rows: Vec<Row> = made
-        .iter()
+    let rows = result_rows(&made, &outcome.results);
+    crate::io::csv::write_rows(&out.join("results.csv"), None, &rows)?;
+    Ok(Report { out, rows })
+}
+
+/// One remesh the experiment made.
+struct Made {
+    model: String,
+    budget: usize,
+    label: &'static str,
+    vertices: usize,
+    triangles: usize,
+    masked_share: f64,
+    seconds: f64,
+}
+
+/// `results.csv`'s rows: each remesh with its scores from the `eval` run.
+fn result_rows(made: &[Made], results: &crate::eval::Results) -> Vec<Row> {
+    let mean = |a: &str, l: &str, metric: Metric| results.mean(a, l, metric).unwrap_or(0.0);
+    made.iter()
         .map(|m| {
             let lod = format!("{}-{}", m.label, m.budget);
             Row {
@@ -249,8 +257,7 @@ pub fn run(config: &Path, log: &mut dyn FnMut(&str)) -> Result<Report> {
                 triangles: m.triangles,
                 masked_share: m.masked_share,
                 flip_mean: mean(&m.model, &lod, Metric::Flip),
-                flip_worst: outcome
-                    .results
+                flip_worst: results
                     .worst(&m.model, &lod, Metric::Flip)
                     .map_or(0.0, |w| w.1),
                 vdp_jnd_mean: mean(&m.model, &lod, Metric::VdpJnd),
@@ -258,9 +265,7 @@ pub fn run(config: &Path, log: &mut dyn FnMut(&str)) -> Result<Report> {
                 seconds: m.seconds,
             }
         })
-        .collect();
-    crate::io::csv::write_rows(&out.join("results.csv"), None, &rows)?;
-    Ok(Report { out, rows })
+        .collect()
 }
 
 /// The `eval` config that scores every remesh: FLIP and the VDP over the 20 dodecahedron views,

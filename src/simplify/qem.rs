@@ -533,53 +533,7 @@ pub fn run(adj: Adjacency, cost: &mut dyn CollapseCost, stop: Stop, diagonal: f6
     let base = adj.clone();
     let mut adj = adj;
     let mut version = vec![0u32; adj.positions.len()];
-    let entry = |adj: &Adjacency, cost: &dyn CollapseCost, version: &[u32], u: u32, v: u32| {
-        // Prefer moving the vertex that may move: collapse the lower class into the higher.
-        let (a, b) = if adj.is_locked(u) || adj.class(u) > adj.class(v) {
-            (v, u)
-        } else {
-            (u, v)
-        };
-        if adj.is_locked(a) {
-            return None;
-        }
-        Some(Entry {
-            cost: (cost.cost(adj, a, b).max(0.0) as f32).to_bits(),
-            a,
-            b,
-            stamp: version[a as usize].wrapping_add(version[b as usize]),
-        })
-    };
-    // The first costs of all edges are independent: evaluated in parallel, then heapified in one
-    // go. Entries are totally ordered (cost, then vertex ids), so the pop order — and the result
-    // — does not depend on the thread count.
-    // Each vertex costs its edges to higher vertices (each edge once), in chunks of vertices.
-    // (Each chunk fills its own vector, and the chunks are joined in order: a flattened
-    // parallel iterator's bookkeeping took 14 M instructions on the bunny, a fifth of the
-    // 65 M the first costs themselves take.)
-    let initial: Vec<Entry> = {
-        let (adj, cost, version) = (&adj, &*cost, &version);
-        let vertices = adj.positions.len() as u32;
-        let chunks: Vec<Vec<Entry>> = (0..vertices.div_ceil(INITIAL_CHUNK))
-            .into_par_iter()
-            .map(|c| {
-                let range = c * INITIAL_CHUNK..((c + 1) * INITIAL_CHUNK).min(vertices);
-                // About three edges per vertex start at the lower end.
-                let mut out = Vec::with_capacity(4 * range.len());
-                for u in range {
-                    for v in adj.ring(u) {
-                        if v > u
-                            && let Some(e) = entry(adj, cost, version, u, v)
-                        {
-                            out.push(e);
-                        }
-                    }
-                }
-                out
-            })
-            .collect();
-        chunks.concat()
-    };
+    let initial = first_entries(&adj, &*cost, &version);
     let mut heap = Lookahead::new(initial, LOOKAHEAD);
     let mut collapses = Vec::new();
     let limit = match stop {
@@ -661,6 +615,62 @@ pub fn run(adj: Adjacency, cost: &mut dyn CollapseCost, stop: Stop, diagonal: f6
         collapses,
         last: adj,
     }
+}
+
+/// The queue entry of edge (u, v): the lower class collapses into the higher (the vertex that
+/// may move moves); `None` where neither end may move.
+#[inline]
+fn entry(
+    adj: &Adjacency,
+    cost: &dyn CollapseCost,
+    version: &[u32],
+    u: u32,
+    v: u32,
+) -> Option<Entry> {
+    let (a, b) = if adj.is_locked(u) || adj.class(u) > adj.class(v) {
+        (v, u)
+    } else {
+        (u, v)
+    };
+    if adj.is_locked(a) {
+        return None;
+    }
+    Some(Entry {
+        cost: (cost.cost(adj, a, b).max(0.0) as f32).to_bits(),
+        a,
+        b,
+        stamp: version[a as usize].wrapping_add(version[b as usize]),
+    })
+}
+
+/// The first costs of all edges are independent: evaluated in parallel, then heapified in one
+/// go. Entries are totally ordered (cost, then vertex ids), so the pop order — and the result
+/// — does not depend on the thread count.
+/// Each vertex costs its edges to higher vertices (each edge once), in chunks of vertices.
+/// (Each chunk fills its own vector, and the chunks are joined in order: a flattened
+/// parallel iterator's bookkeeping took 14 M instructions on the bunny, a fifth of the
+/// 65 M the first costs themselves take.)
+fn first_entries(adj: &Adjacency, cost: &dyn CollapseCost, version: &[u32]) -> Vec<Entry> {
+    let vertices = adj.positions.len() as u32;
+    let chunks: Vec<Vec<Entry>> = (0..vertices.div_ceil(INITIAL_CHUNK))
+        .into_par_iter()
+        .map(|c| {
+            let range = c * INITIAL_CHUNK..((c + 1) * INITIAL_CHUNK).min(vertices);
+            // About three edges per vertex start at the lower end.
+            let mut out = Vec::with_capacity(4 * range.len());
+            for u in range {
+                for v in adj.ring(u) {
+                    if v > u
+                        && let Some(e) = entry(adj, cost, version, u, v)
+                    {
+                        out.push(e);
+                    }
+                }
+            }
+            out
+        })
+        .collect();
+    chunks.concat()
 }
 
 /// The progressive record of `mesh` down to `stop`, with attribute-aware quadrics.
