@@ -140,25 +140,7 @@ pub fn merge(dirs: &[PathBuf], out: &Path) -> Result<Outcome> {
         return Err(Error::Usage("merge needs at least one shard folder".into()));
     }
     // The shards: manifests, each folder's files against its manifest, the tables.
-    let mut manifests = Vec::new();
-    for d in dirs {
-        let path = d.join("shard.json");
-        let text = crate::io::read_input_text(
-            &path,
-            "shard manifest",
-            crate::limits::CONFIG_BYTES,
-            "give folders written by `lodeval eval --shard`",
-        )?;
-        let m: Manifest = serde_json::from_str(&text).map_err(|e| {
-            Error::input(
-                &path,
-                format!("is not an lodeval shard manifest: {e}"),
-                "give folders written by `lodeval eval --shard`",
-            )
-        })?;
-        manifest::verify(d, &m)?;
-        manifests.push(m);
-    }
+    let manifests = read_manifests(dirs)?;
     let first = &manifests[0];
     for (m, d) in manifests.iter().zip(dirs).skip(1) {
         manifest::check_same_inputs(first, &dirs[0], m, d)?;
@@ -196,39 +178,7 @@ pub fn merge(dirs: &[PathBuf], out: &Path) -> Result<Outcome> {
     let mut results = Results::default();
     for (d, m) in dirs.iter().zip(&manifests) {
         let r = Results::read_csvs(d)?;
-        // Every row belongs to one of the shard's own cases.
-        let cases = r.rows.iter().map(|x| (&x.asset, &x.lod));
-        let cases = cases.chain(r.lods.iter().map(|x| (&x.asset, &x.lod)));
-        let cases = cases.chain(r.distances.iter().map(|x| (&x.asset, &x.lod)));
-        for (asset, lod) in cases {
-            let id = plan::case_id(asset, lod);
-            if !m.cases.contains(&id) {
-                return Err(Error::input(
-                    &d.join("shard.json"),
-                    format!("the shard's tables hold case {id}, which it did not run"),
-                    manifest::FIX,
-                ));
-            }
-        }
-        // And every case the shard ran has its rows.
-        for c in &m.cases {
-            let has = |a: &String, l: &String| plan::case_id(a, l) == *c;
-            let lods = r.lods.iter().filter(|x| has(&x.asset, &x.lod)).count();
-            if lods != 1 || !r.rows.iter().any(|x| has(&x.asset, &x.lod)) {
-                return Err(Error::input(
-                    &d.join("shard.json"),
-                    format!(
-                        "case {c} has {lods} rows in lods.csv and its metrics rows are {}",
-                        if r.rows.iter().any(|x| has(&x.asset, &x.lod)) {
-                            "there"
-                        } else {
-                            "missing"
-                        }
-                    ),
-                    manifest::FIX,
-                ));
-            }
-        }
+        check_shard_tables(d, m, &r)?;
         results.rows.extend(r.rows);
         results.lods.extend(r.lods);
         results.distances.extend(r.distances);
@@ -265,6 +215,68 @@ pub fn merge(dirs: &[PathBuf], out: &Path) -> Result<Outcome> {
             .collect(),
     };
     finish(plan, dir, results, &manifest)
+}
+
+/// Each shard folder's manifest, with the folder's files checked against it.
+fn read_manifests(dirs: &[PathBuf]) -> Result<Vec<Manifest>> {
+    let mut manifests = Vec::new();
+    for d in dirs {
+        let path = d.join("shard.json");
+        let text = crate::io::read_input_text(
+            &path,
+            "shard manifest",
+            crate::limits::CONFIG_BYTES,
+            "give folders written by `lodeval eval --shard`",
+        )?;
+        let m: Manifest = serde_json::from_str(&text).map_err(|e| {
+            Error::input(
+                &path,
+                format!("is not an lodeval shard manifest: {e}"),
+                "give folders written by `lodeval eval --shard`",
+            )
+        })?;
+        manifest::verify(d, &m)?;
+        manifests.push(m);
+    }
+    Ok(manifests)
+}
+
+/// A shard's tables hold its own cases only, and every case it ran has its rows.
+fn check_shard_tables(d: &Path, m: &Manifest, r: &Results) -> Result<()> {
+    // Every row belongs to one of the shard's own cases.
+    let cases = r.rows.iter().map(|x| (&x.asset, &x.lod));
+    let cases = cases.chain(r.lods.iter().map(|x| (&x.asset, &x.lod)));
+    let cases = cases.chain(r.distances.iter().map(|x| (&x.asset, &x.lod)));
+    for (asset, lod) in cases {
+        let id = plan::case_id(asset, lod);
+        if !m.cases.contains(&id) {
+            return Err(Error::input(
+                &d.join("shard.json"),
+                format!("the shard's tables hold case {id}, which it did not run"),
+                manifest::FIX,
+            ));
+        }
+    }
+    // And every case the shard ran has its rows.
+    for c in &m.cases {
+        let has = |a: &String, l: &String| plan::case_id(a, l) == *c;
+        let lods = r.lods.iter().filter(|x| has(&x.asset, &x.lod)).count();
+        if lods != 1 || !r.rows.iter().any(|x| has(&x.asset, &x.lod)) {
+            return Err(Error::input(
+                &d.join("shard.json"),
+                format!(
+                    "case {c} has {lods} rows in lods.csv and its metrics rows are {}",
+                    if r.rows.iter().any(|x| has(&x.asset, &x.lod)) {
+                        "there"
+                    } else {
+                        "missing"
+                    }
+                ),
+                manifest::FIX,
+            ));
+        }
+    }
+    Ok(())
 }
 
 /// Whether `a` and `b` are the same folder or one lies inside the other ([`crate::io::target`]:

@@ -99,59 +99,70 @@ pub fn write(plan: &Plan, results: &Results, dir: &Path) -> Result<()> {
                 &chart,
             )?;
         }
-        let mut criteria: Vec<&str> = Vec::new();
-        for d in results.distances.iter().filter(|d| d.asset == asset.name) {
-            if !criteria.contains(&d.criterion.as_str()) {
-                criteria.push(&d.criterion);
-            }
-        }
-        if criteria.is_empty() {
-            continue;
-        }
-        let lines = criteria
-            .iter()
-            .map(|c| {
-                let mut line = Line {
-                    name: c.to_string(),
-                    ..Line::default()
-                };
-                for d in results
-                    .distances
-                    .iter()
-                    .filter(|d| d.asset == asset.name && d.criterion == *c)
-                {
-                    line.points.push((d.triangles as f64, d.diameter_px));
-                    line.labels.push(format!(
-                        "{} {} px · {} m",
-                        d.lod,
-                        d.diameter_text(),
-                        d.distance_text()
-                    ));
-                }
-                line
-            })
-            .collect();
-        let chart = Chart {
-            title: format!("{} — where each LOD becomes imperceptible", asset.name),
-            subtitle: format!(
-                "{}; smaller is better: the LOD can be used from this size down",
-                view_conditions(plan)
-            ),
-            x_label: "triangles (log scale)".into(),
-            y_label: "on-screen diameter, px".into(),
-            lines,
-            log_x: true,
-            h_marks: Vec::new(),
-            v_marks: vec![original],
-            tight_y: false,
-        };
-        plot_png::write(
-            &dir.join("plots")
-                .join(format!("{}-distances.png", asset.name)),
-            &chart,
-        )?;
+        distance_chart(plan, results, &asset.name, original, dir)?;
     }
     Ok(())
+}
+
+/// `ASSET-distances.png`, when distances were searched: the on-screen diameter (pixels) beyond
+/// which each LOD is imperceptible, one line per criterion.
+fn distance_chart(
+    plan: &Plan,
+    results: &Results,
+    asset: &str,
+    original: Mark,
+    dir: &Path,
+) -> Result<()> {
+    let mut criteria: Vec<&str> = Vec::new();
+    for d in results.distances.iter().filter(|d| d.asset == asset) {
+        if !criteria.contains(&d.criterion.as_str()) {
+            criteria.push(&d.criterion);
+        }
+    }
+    if criteria.is_empty() {
+        return Ok(());
+    }
+    let lines = criteria
+        .iter()
+        .map(|c| {
+            let mut line = Line {
+                name: c.to_string(),
+                ..Line::default()
+            };
+            for d in results
+                .distances
+                .iter()
+                .filter(|d| d.asset == asset && d.criterion == *c)
+            {
+                line.points.push((d.triangles as f64, d.diameter_px));
+                line.labels.push(format!(
+                    "{} {} px · {} m",
+                    d.lod,
+                    d.diameter_text(),
+                    d.distance_text()
+                ));
+            }
+            line
+        })
+        .collect();
+    let chart = Chart {
+        title: format!("{} — where each LOD becomes imperceptible", asset),
+        subtitle: format!(
+            "{}; smaller is better: the LOD can be used from this size down",
+            view_conditions(plan)
+        ),
+        x_label: "triangles (log scale)".into(),
+        y_label: "on-screen diameter, px".into(),
+        lines,
+        log_x: true,
+        h_marks: Vec::new(),
+        v_marks: vec![original],
+        tight_y: false,
+    };
+    plot_png::write(
+        &dir.join("plots").join(format!("{asset}-distances.png")),
+        &chart,
+    )
 }
 
 fn view_conditions(plan: &Plan) -> String {

@@ -59,52 +59,12 @@ impl LumaViews {
                 }
             }
         }
-        let tiles_x = width.div_ceil(BUCKET);
-        let n_tiles = (tiles_x * height.div_ceil(BUCKET)) as usize;
         let mut targets = targets.map(|t| t.into_iter());
         let mut views: Vec<View> = cameras
             .iter()
             .map(|camera| {
-                let (mvp, _) = camera_setup(camera, width, height);
-                let half = fixed::ONE_PIXEL as i32 / 2;
-                View {
-                    mvp,
-                    planes: ClipPlanes::for_viewport(width, height),
-                    vp: Viewport {
-                        width,
-                        height,
-                        cull_backfaces: false,
-                        sample_span: [half, half, half, half],
-                    },
-                    lights: ResolvedLight::for_camera(&scene.lights_for(false), camera),
-                    xf: Vec::new(),
-                    light: Vec::new(),
-                    pieces: Vec::new(),
-                    bbox: Vec::new(),
-                    buckets: vec![Vec::new(); n_tiles],
-                    tiles_x,
-                    px: {
-                        let target = targets.as_mut().and_then(|t| t.next());
-                        let blank = Pixel {
-                            shown: EMPTY,
-                            depth: f32::INFINITY,
-                            current: shared.background,
-                            target: shared.background,
-                        };
-                        let mut px = vec![blank; n];
-                        for (p, t) in px.iter_mut().zip(target.iter().flatten()) {
-                            p.target = *t;
-                        }
-                        px
-                    },
-                    second: vec![[Layer::NONE; 2]; n],
-                    shown_count: Vec::new(),
-                    tile_far: vec![f32::INFINITY; n_tiles],
-                    id: NEXT_VIEW_ID.fetch_add(1, std::sync::atomic::Ordering::Relaxed),
-                    trial: Trial::default(),
-                    commits: 0,
-                    fills: Fills::default(),
-                }
+                let target = targets.as_mut().and_then(|t| t.next());
+                View::blank(camera, scene, &shared, target)
             })
             .collect();
         // The first render is a trial that changes everything.
@@ -281,5 +241,60 @@ impl LumaViews {
         }
         // Restoring a few saved values per view: cheaper than waking the thread pool.
         self.views.iter_mut().for_each(|v| v.revert());
+    }
+}
+
+impl View {
+    /// A view from `camera` with nothing rendered yet: every pixel the background, its target
+    /// the given image's (or the background until the first render sets it).
+    fn blank(
+        camera: &Camera,
+        scene: &RenderScene,
+        shared: &Shared,
+        target: Option<Vec<u16>>,
+    ) -> View {
+        let (width, height) = (shared.width, shared.height);
+        let n = (width * height) as usize;
+        let tiles_x = width.div_ceil(BUCKET);
+        let n_tiles = (tiles_x * height.div_ceil(BUCKET)) as usize;
+        let (mvp, _) = camera_setup(camera, width, height);
+        let half = fixed::ONE_PIXEL as i32 / 2;
+        View {
+            mvp,
+            planes: ClipPlanes::for_viewport(width, height),
+            vp: Viewport {
+                width,
+                height,
+                cull_backfaces: false,
+                sample_span: [half, half, half, half],
+            },
+            lights: ResolvedLight::for_camera(&scene.lights_for(false), camera),
+            xf: Vec::new(),
+            light: Vec::new(),
+            pieces: Vec::new(),
+            bbox: Vec::new(),
+            buckets: vec![Vec::new(); n_tiles],
+            tiles_x,
+            px: {
+                let blank = Pixel {
+                    shown: EMPTY,
+                    depth: f32::INFINITY,
+                    current: shared.background,
+                    target: shared.background,
+                };
+                let mut px = vec![blank; n];
+                for (p, t) in px.iter_mut().zip(target.iter().flatten()) {
+                    p.target = *t;
+                }
+                px
+            },
+            second: vec![[Layer::NONE; 2]; n],
+            shown_count: Vec::new(),
+            tile_far: vec![f32::INFINITY; n_tiles],
+            id: NEXT_VIEW_ID.fetch_add(1, std::sync::atomic::Ordering::Relaxed),
+            trial: Trial::default(),
+            commits: 0,
+            fills: Fills::default(),
+        }
     }
 }
