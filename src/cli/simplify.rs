@@ -92,38 +92,10 @@ pub(crate) struct SimplifyArgs {
 /// Run `simplify`.
 pub(crate) fn run(a: SimplifyArgs, quiet: bool) -> Result<(), Error> {
     if let Some(config) = &a.experiment {
-        if lodeval::experiments::paper_of(config)? == "menzel-guthe2010" {
-            let report = lodeval::experiments::menzel_guthe2010::run(config, &mut |line| {
-                if !quiet {
-                    note!("{line}")
-                }
-            })?;
-            return emit(&format!(
-                "{} Table 2 rows, {} Figure 1 materials, {} study LODs written\n",
-                report.table2.len(),
-                report.figure1.len(),
-                report.study.len()
-            ));
-        }
-        let rows = lodeval::experiments::williams2003::run(config, &mut |line| note!("{line}"))?;
-        note!("{} curve points written", rows.len());
-        return Ok(());
+        return experiment(config, quiet);
     }
     if a.method == Method::Williams {
-        let report = lodeval::app::simplify_williams(&williams_job(&a)?)?;
-        super::print::warnings(&report.warnings);
-        if a.json {
-            return emit_json(&report.rows);
-        }
-        for r in &report.rows {
-            emit(&format!(
-                "{}  {} triangles ({:.4} of the input)\n",
-                r.file.display(),
-                r.triangles,
-                r.ratio
-            ))?;
-        }
-        return Ok(());
+        return williams(&a);
     }
     // Flags of Williams et al. that another method would ignore: said, not silently dropped.
     let williams_only: Vec<&str> = [
@@ -215,6 +187,44 @@ pub(crate) fn run(a: SimplifyArgs, quiet: bool) -> Result<(), Error> {
         ));
     }
     emit(&text)
+}
+
+/// `simplify --experiment CONFIG`: Menzel & Guthe's or Williams et al.'s reproduction.
+fn experiment(config: &std::path::Path, quiet: bool) -> Result<(), Error> {
+    if lodeval::experiments::paper_of(config)? == "menzel-guthe2010" {
+        let report = lodeval::experiments::menzel_guthe2010::run(config, &mut |line| {
+            if !quiet {
+                note!("{line}")
+            }
+        })?;
+        return emit(&format!(
+            "{} Table 2 rows, {} Figure 1 materials, {} study LODs written\n",
+            report.table2.len(),
+            report.figure1.len(),
+            report.study.len()
+        ));
+    }
+    let rows = lodeval::experiments::williams2003::run(config, &mut |line| note!("{line}"))?;
+    note!("{} curve points written", rows.len());
+    Ok(())
+}
+
+/// `simplify --method williams`.
+fn williams(a: &SimplifyArgs) -> Result<(), Error> {
+    let report = lodeval::app::simplify_williams(&williams_job(a)?)?;
+    super::print::warnings(&report.warnings);
+    if a.json {
+        return emit_json(&report.rows);
+    }
+    for r in &report.rows {
+        emit(&format!(
+            "{}  {} triangles ({:.4} of the input)\n",
+            r.file.display(),
+            r.triangles,
+            r.ratio
+        ))?;
+    }
+    Ok(())
 }
 
 /// Tell the user (stderr) when a LOD stopped well above its triangle goal: the simplifier ran out

@@ -45,12 +45,6 @@ pub fn minimize(
         pts.push(p);
         evals += 1;
     }
-    let best_of = |pts: &[Vec<f64>], vals: &[f64]| {
-        let k = (0..vals.len())
-            .min_by(|&a, &b| vals[a].total_cmp(&vals[b]).then(a.cmp(&b)))
-            .unwrap_or(0);
-        (pts[k].clone(), vals[k])
-    };
     if pts.len() < n + 1 || n == 0 {
         let (point, value) = best_of(&pts, &vals);
         return Minimum {
@@ -63,12 +57,6 @@ pub fn minimize(
     let floor = -3 * n as i64;
     let mut centroid = vec![0.0; n];
     let mut trial = vec![0.0; n];
-    // Point on the line through the worst vertex and the centroid of the others:
-    // c + t·(worst − c).
-    let along = |c: &[f64], worst: &[f64], t: f64, out: &mut Vec<f64>| {
-        out.clear();
-        out.extend(c.iter().zip(worst).map(|(c, w)| c + t * (w - c)));
-    };
     while evals < max_evals {
         // Order: best (lowest), worst, second worst; ties by index keep it deterministic.
         let mut order: Vec<usize> = (0..=n).collect();
@@ -77,15 +65,7 @@ pub fn minimize(
         if vals[hi] == vals[lo] || log2_volume <= floor {
             break;
         }
-        centroid.iter_mut().for_each(|c| *c = 0.0);
-        for (k, p) in pts.iter().enumerate() {
-            if k != hi {
-                centroid
-                    .iter_mut()
-                    .zip(p)
-                    .for_each(|(c, x)| *c += x / n as f64);
-            }
-        }
+        centroid_without(&pts, hi, &mut centroid);
         // Reflect.
         along(&centroid, &pts[hi], -1.0, &mut trial);
         let fr = f(&trial);
@@ -146,6 +126,32 @@ pub fn minimize(
         point,
         value,
         evals,
+    }
+}
+
+/// The vertex with the lowest value (the first on ties) and its value.
+fn best_of(pts: &[Vec<f64>], vals: &[f64]) -> (Vec<f64>, f64) {
+    let k = (0..vals.len())
+        .min_by(|&a, &b| vals[a].total_cmp(&vals[b]).then(a.cmp(&b)))
+        .unwrap_or(0);
+    (pts[k].clone(), vals[k])
+}
+
+/// The point on the line through the worst vertex and the centroid of the others:
+/// c + t·(worst − c), into `out`.
+fn along(c: &[f64], worst: &[f64], t: f64, out: &mut Vec<f64>) {
+    out.clear();
+    out.extend(c.iter().zip(worst).map(|(c, w)| c + t * (w - c)));
+}
+
+/// The centroid of every vertex but `hi` (of n + 1), into `out`.
+fn centroid_without(pts: &[Vec<f64>], hi: usize, out: &mut [f64]) {
+    let n = out.len();
+    out.iter_mut().for_each(|c| *c = 0.0);
+    for (k, p) in pts.iter().enumerate() {
+        if k != hi {
+            out.iter_mut().zip(p).for_each(|(c, x)| *c += x / n as f64);
+        }
     }
 }
 
