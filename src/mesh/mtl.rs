@@ -48,50 +48,8 @@ pub(super) fn material(
     warnings: &mut Vec<String>,
 ) -> Result<Material> {
     let param = |key: &str| m.unknown_param.get(key).map(|v| v.trim().to_string());
-    let scalar = |key: &str| -> Result<Option<f32>> {
-        param(key)
-            .map(|v| {
-                v.split_whitespace()
-                    .next()
-                    .and_then(|t| t.parse::<f32>().ok())
-                    .ok_or_else(|| {
-                        Error::input_at(
-                            ctx.obj,
-                            Location::Element(format!("material '{}'", m.name)),
-                            format!("{key} '{v}' is not a number"),
-                            "fix the value in the .mtl file",
-                        )
-                    })
-            })
-            .transpose()
-    };
-    let nvdiffrec = param("bsdf").is_some_and(|b| b == "pbr");
-    let is_pbr = nvdiffrec || PBR_KEYS.iter().any(|k| m.unknown_param.contains_key(*k));
-    let diffuse = m.diffuse.map_or(Vec3::splat(0.8), Vec3::from);
-    let mut mat = if is_pbr {
-        let (mut metallic, mut roughness) = (0.0, 1.0);
-        if let (true, Some([_, r, mm])) = (nvdiffrec, m.specular) {
-            (metallic, roughness) = (mm, r);
-        }
-        roughness = scalar("Pr")?.unwrap_or(roughness);
-        metallic = scalar("Pm")?.unwrap_or(metallic);
-        Material::metallic_roughness(&m.name, diffuse, metallic, roughness)
-    } else {
-        let mut mat = Material::default_material();
-        mat.base_color = diffuse;
-        if let Some(ks) = m.specular {
-            mat.specular = Vec3::from(ks);
-        }
-        if let Some(ns) = m.shininess {
-            mat.shininess = ns.max(1.0);
-        }
-        let (metallic, roughness) =
-            Material::metallic_roughness_from_specular(mat.base_color, mat.specular, mat.shininess);
-        (mat.metallic, mat.roughness) = (metallic, roughness);
-        mat
-    };
+    let mut mat = base_material(m, ctx)?;
     mat.name = m.name.clone();
-    debug_assert_eq!(mat.model == Model::MetallicRoughness, is_pbr);
     if let Some(ke) = m.emissive {
         mat.emissive = Vec3::from(ke);
     }
@@ -160,6 +118,56 @@ pub(super) fn material(
             m.name
         ));
     }
+    Ok(mat)
+}
+
+/// The material's model and factors: metallic–roughness where the MTL has PBR keys (or is
+/// nvdiffrec's `bsdf pbr`), else Blinn–Phong with a metallic–roughness equivalent.
+fn base_material(m: &tobj::Material, ctx: &MtlContext) -> Result<Material> {
+    let param = |key: &str| m.unknown_param.get(key).map(|v| v.trim().to_string());
+    let scalar = |key: &str| -> Result<Option<f32>> {
+        param(key)
+            .map(|v| {
+                v.split_whitespace()
+                    .next()
+                    .and_then(|t| t.parse::<f32>().ok())
+                    .ok_or_else(|| {
+                        Error::input_at(
+                            ctx.obj,
+                            Location::Element(format!("material '{}'", m.name)),
+                            format!("{key} '{v}' is not a number"),
+                            "fix the value in the .mtl file",
+                        )
+                    })
+            })
+            .transpose()
+    };
+    let nvdiffrec = param("bsdf").is_some_and(|b| b == "pbr");
+    let is_pbr = nvdiffrec || PBR_KEYS.iter().any(|k| m.unknown_param.contains_key(*k));
+    let diffuse = m.diffuse.map_or(Vec3::splat(0.8), Vec3::from);
+    let mat = if is_pbr {
+        let (mut metallic, mut roughness) = (0.0, 1.0);
+        if let (true, Some([_, r, mm])) = (nvdiffrec, m.specular) {
+            (metallic, roughness) = (mm, r);
+        }
+        roughness = scalar("Pr")?.unwrap_or(roughness);
+        metallic = scalar("Pm")?.unwrap_or(metallic);
+        Material::metallic_roughness(&m.name, diffuse, metallic, roughness)
+    } else {
+        let mut mat = Material::default_material();
+        mat.base_color = diffuse;
+        if let Some(ks) = m.specular {
+            mat.specular = Vec3::from(ks);
+        }
+        if let Some(ns) = m.shininess {
+            mat.shininess = ns.max(1.0);
+        }
+        let (metallic, roughness) =
+            Material::metallic_roughness_from_specular(mat.base_color, mat.specular, mat.shininess);
+        (mat.metallic, mat.roughness) = (metallic, roughness);
+        mat
+    };
+    debug_assert_eq!(mat.model == Model::MetallicRoughness, is_pbr);
     Ok(mat)
 }
 

@@ -247,21 +247,11 @@ impl AttributeQuadrics {
     /// is singular (a pivot below 1e-12 of its trace: too few faces) the attributes stay at
     /// `keep`'s and the value is the quadric there.
     // Dense linear algebra on fixed-size arrays: index loops read like the formulas.
-    #[allow(clippy::needless_range_loop)]
-    fn reduced<const N: usize, const M: usize, const S: usize, const WANT_ATTRS: bool>(
-        &self,
-        wedges: &[u32],
-        x: DVec3,
-        keep: &Wedge,
-        attrs: &mut [f64; MAX_M],
-    ) -> f64 {
-        let m = M;
-        let stride = S;
-        debug_assert_eq!((M, S), (N - 3, N * (N + 1) / 2 + N + 1));
-        debug_assert_eq!(stride, self.stride);
-        let off = N * (N + 1) / 2;
-        // Sum the wedges' packed quadrics.
+    /// The sum of the wedges' packed quadrics (`S` values each).
+    #[inline(always)]
+    fn summed<const S: usize>(&self, wedges: &[u32]) -> [f64; S] {
         let mut q = [0.0f64; S];
+        let stride = self.stride;
         let quadric = |w: u32| &self.data[w as usize * stride..(w as usize + 1) * stride];
         // The first two at once (a collapse's usual group; no copy of the first on its own).
         // (Zipped iterators: no bounds checks, so the sums vectorize.)
@@ -283,6 +273,23 @@ impl AttributeQuadrics {
                 *s += x;
             }
         }
+        q
+    }
+
+    #[allow(clippy::needless_range_loop)]
+    fn reduced<const N: usize, const M: usize, const S: usize, const WANT_ATTRS: bool>(
+        &self,
+        wedges: &[u32],
+        x: DVec3,
+        keep: &Wedge,
+        attrs: &mut [f64; MAX_M],
+    ) -> f64 {
+        let m = M;
+        let stride = S;
+        debug_assert_eq!((M, S), (N - 3, N * (N + 1) / 2 + N + 1));
+        debug_assert_eq!(stride, self.stride);
+        let off = N * (N + 1) / 2;
+        let q: [f64; S] = self.summed(wedges);
         let at = |i: usize, j: usize| q[tri_index(N, i, j)];
         let xs = [x.x, x.y, x.z];
         // The position-only part: xᵀA_xx·x + 2·b_x·x + c.
