@@ -44,6 +44,7 @@ impl CalibrationSet {
 
 /// A `lodeval calibrate` request.
 #[derive(Debug, Clone)]
+#[non_exhaustive]
 pub struct CalibrateJob {
     /// Which data.
     pub set: CalibrationSet,
@@ -55,6 +56,20 @@ pub struct CalibrateJob {
     pub dataset: Option<String>,
     /// Where to write each dataset's table (.csv) and plot (.svg) (none: nothing written).
     pub out: Option<PathBuf>,
+}
+
+impl CalibrateJob {
+    /// `set` against its shipped data at ModelFest's condition, every dataset, no files
+    /// written.
+    pub fn new(set: CalibrationSet) -> CalibrateJob {
+        CalibrateJob {
+            set,
+            data: set.default_data(),
+            condition: Condition::MODELFEST,
+            dataset: None,
+            out: None,
+        }
+    }
 }
 
 /// What `calibrate` found, per dataset asked for.

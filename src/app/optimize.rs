@@ -7,6 +7,7 @@ use crate::mesh::{self, LoadOptions};
 
 /// What `lodeval optimize` does.
 #[derive(Debug, Clone)]
+#[non_exhaustive]
 pub struct OptimizeJob {
     /// The original (target) mesh.
     pub original: PathBuf,
@@ -18,6 +19,20 @@ pub struct OptimizeJob {
     pub energy_csv: Option<PathBuf>,
     /// Optimizer settings.
     pub options: crate::simplify::lindstrom_turk::Options,
+}
+
+impl OptimizeJob {
+    /// Optimize `simplified` towards `original` into `out` with the default options, no energy
+    /// log.
+    pub fn new(original: PathBuf, simplified: PathBuf, out: PathBuf) -> OptimizeJob {
+        OptimizeJob {
+            original,
+            simplified,
+            out,
+            energy_csv: None,
+            options: crate::simplify::lindstrom_turk::Options::DEFAULT,
+        }
+    }
 }
 
 /// Run the image-driven optimizer and write the mesh (and the energy log).

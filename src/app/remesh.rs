@@ -11,6 +11,7 @@ use crate::simplify::qu_meyer::{self, Options, Seconds};
 
 /// A `lodeval remesh` request.
 #[derive(Debug, Clone)]
+#[non_exhaustive]
 pub struct RemeshJob {
     /// Input mesh (with texture coordinates).
     pub mesh: PathBuf,
@@ -20,6 +21,18 @@ pub struct RemeshJob {
     pub options: Options,
     /// Folder for the maps as PNG (signal, masking, curvature, density, samples).
     pub maps: Option<PathBuf>,
+}
+
+impl RemeshJob {
+    /// `mesh` remeshed with `options` into `out`, no maps written.
+    pub fn new(mesh: PathBuf, out: PathBuf, options: Options) -> RemeshJob {
+        RemeshJob {
+            mesh,
+            out,
+            options,
+            maps: None,
+        }
+    }
 }
 
 /// What `remesh` wrote.

@@ -33,6 +33,7 @@ pub enum ViewSelection {
 
 /// A `lodeval render` request.
 #[derive(Debug, Clone)]
+#[non_exhaustive]
 pub struct RenderJob {
     /// Mesh file.
     pub mesh: PathBuf,
@@ -53,6 +54,24 @@ pub struct RenderJob {
     /// Also write every view's camera here as JSON (eye, target, up, vertical field of view,
     /// near, far), to set the same view up in another renderer.
     pub cameras_json: Option<PathBuf>,
+}
+
+impl RenderJob {
+    /// `views` of `mesh`: default loading, settings and lighting, the dodecahedron rig, PNG, the
+    /// CPU reference, no cameras file.
+    pub fn new(mesh: PathBuf, views: ViewSelection) -> RenderJob {
+        RenderJob {
+            mesh,
+            load: LoadOptions::DEFAULT,
+            settings: RenderSettings::DEFAULT,
+            rig: Rig::Dodecahedron,
+            views,
+            exr: false,
+            backend: crate::backend::Backend::Cpu,
+            lighting: crate::scene::Lighting::default(),
+            cameras_json: None,
+        }
+    }
 }
 
 /// One camera as `--cameras` writes it.

@@ -9,6 +9,7 @@ use crate::scene::{Camera, Rig};
 
 /// A `lodeval simplify` request.
 #[derive(Debug, Clone)]
+#[non_exhaustive]
 pub struct SimplifyJob {
     /// Input mesh.
     pub mesh: PathBuf,
@@ -24,6 +25,27 @@ pub struct SimplifyJob {
     pub meters_per_unit: f64,
     /// How a glTF chain's switch points are measured (shading, lighting, display).
     pub look: crate::eval::config::Look,
+}
+
+impl SimplifyJob {
+    /// `mesh` to `goals` with `method` into `out`: one file per goal, one metre per unit, the
+    /// default look.
+    pub fn new(
+        mesh: PathBuf,
+        out: PathBuf,
+        method: crate::simplify::Method,
+        goals: Vec<crate::simplify::Goal>,
+    ) -> SimplifyJob {
+        SimplifyJob {
+            mesh,
+            out,
+            method,
+            goals,
+            chain: false,
+            meters_per_unit: 1.0,
+            look: crate::eval::config::Look::default(),
+        }
+    }
 }
 
 /// One written LOD.
@@ -248,6 +270,7 @@ pub enum WilliamsViews {
 
 /// A `lodeval simplify --method williams` request.
 #[derive(Debug, Clone)]
+#[non_exhaustive]
 pub struct WilliamsJob {
     /// Input mesh.
     pub mesh: PathBuf,
@@ -264,6 +287,26 @@ pub struct WilliamsJob {
     pub criterion: crate::simplify::williams::Criterion,
     /// Image size (pixels) the views are seen at.
     pub size: u32,
+}
+
+impl WilliamsJob {
+    /// `mesh` to `goal` into `out`: one static LOD for the 20 views of the dodecahedron rig,
+    /// Gouraud shading, the paper's perceptual criterion, 512² views.
+    pub fn new(
+        mesh: PathBuf,
+        out: PathBuf,
+        goal: crate::simplify::williams::StaticGoal,
+    ) -> WilliamsJob {
+        WilliamsJob {
+            mesh,
+            out,
+            goal,
+            views: WilliamsViews::All(Rig::Dodecahedron),
+            shading: crate::raster::Shading::Gouraud,
+            criterion: crate::simplify::williams::Criterion::Perceptual,
+            size: 512,
+        }
+    }
 }
 
 /// Simplify with Williams et al. 2003 and write the LOD as OBJ, or as a one-level glTF.

@@ -49,16 +49,16 @@ pub(crate) fn run(a: CalibrateArgs) -> Result<(), Error> {
             "--dataset picks one of castleCSF's datasets: use it with `calibrate castle`".into(),
         ));
     }
-    let job = lodeval::app::CalibrateJob {
-        set,
-        data: a.data.clone().unwrap_or_else(|| set.default_data()),
-        condition: lodeval::metric::vdp::modelfest::Condition {
-            ppd: a.ppd,
-            background_cd_m2: a.background_cd_m2,
-        },
-        dataset: a.dataset.clone(),
-        out: a.out.clone(),
+    let mut job = lodeval::app::CalibrateJob::new(set);
+    if let Some(data) = &a.data {
+        job.data = data.clone();
+    }
+    job.condition = lodeval::metric::vdp::modelfest::Condition {
+        ppd: a.ppd,
+        background_cd_m2: a.background_cd_m2,
     };
+    job.dataset = a.dataset.clone();
+    job.out = a.out.clone();
     let report = lodeval::app::calibrate(&job)?;
     if a.json {
         return emit_json(&report);

@@ -86,13 +86,9 @@ pub(crate) fn run(a: OptimizeArgs, quiet: bool) -> Result<(), Error> {
     options.seed = a.seed;
     options.normals = normals;
     options.attributes = !a.no_attributes;
-    let job = lodeval::app::OptimizeJob {
-        original,
-        simplified,
-        out: out.clone(),
-        energy_csv: a.energy_csv,
-        options,
-    };
+    let mut job = lodeval::app::OptimizeJob::new(original, simplified, out.clone());
+    job.energy_csv = a.energy_csv;
+    job.options = options;
     let o = lodeval::app::optimize(&job, &Reporter::new(quiet))?;
     emit(&format!(
         "{}  {} vertices  d_MS {:.6e} -> {:.6e} ({:.1} % of the input's energy)  {} evaluations in {:.1} s ({:.0}/s)  accepted: {} no-op, {} swap, {} teleport\n",

@@ -82,12 +82,9 @@ pub(crate) fn run(a: RemeshArgs, quiet: bool) -> Result<(), Error> {
     if let Some(ppd) = a.ppd {
         options.ppd = ppd;
     }
-    let report = lodeval::app::remesh(&lodeval::app::RemeshJob {
-        mesh,
-        out,
-        options,
-        maps: a.maps,
-    })?;
+    let mut job = lodeval::app::RemeshJob::new(mesh, out, options);
+    job.maps = a.maps;
+    let report = lodeval::app::remesh(&job)?;
     super::print::warnings(&report.warnings);
     if a.json {
         return emit_json(&report);

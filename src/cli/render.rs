@@ -96,17 +96,15 @@ impl RenderArgs {
                 ));
             }
         };
-        Ok(RenderJob {
-            mesh: self.mesh,
-            load: self.load.options()?,
-            settings,
-            rig: self.rig,
-            views,
-            exr: self.exr,
-            backend: self.backend,
-            lighting,
-            cameras_json: self.cameras,
-        })
+        let mut job = RenderJob::new(self.mesh, views);
+        job.load = self.load.options()?;
+        job.settings = settings;
+        job.rig = self.rig;
+        job.exr = self.exr;
+        job.backend = self.backend;
+        job.lighting = lighting;
+        job.cameras_json = self.cameras;
+        Ok(job)
     }
 }
 

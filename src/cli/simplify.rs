@@ -143,15 +143,15 @@ pub(crate) fn run(a: SimplifyArgs, quiet: bool) -> Result<(), Error> {
     // once it is.
     lodeval::simplify::goals::check(method, &goals, None)
         .map_err(|why| Error::Usage(format!("{flag}: {why}")))?;
-    let job = lodeval::app::SimplifyJob {
-        mesh: a.mesh.expect("clap requires it"),
-        out: a.out.expect("clap requires it"),
+    let mut job = lodeval::app::SimplifyJob::new(
+        a.mesh.expect("clap requires it"),
+        a.out.expect("clap requires it"),
         method,
-        chain: !a.chain.is_empty(),
-        goals: goals.clone(),
-        meters_per_unit: a.meters_per_unit,
-        look: a.look.look(a.shading),
-    };
+        goals.clone(),
+    );
+    job.chain = !a.chain.is_empty();
+    job.meters_per_unit = a.meters_per_unit;
+    job.look = a.look.look(a.shading);
     let report = lodeval::app::simplify(&job, &Reporter::new(quiet))?;
     super::print::warnings(&report.warnings);
     let rows = report.rows;
@@ -295,23 +295,24 @@ pub(crate) fn williams_job(a: &SimplifyArgs) -> Result<lodeval::app::WilliamsJob
             ));
         }
     };
-    Ok(lodeval::app::WilliamsJob {
-        mesh: a.mesh.clone().expect("clap requires it"),
-        out: a.out.clone().expect("clap requires it"),
+    let mut job = lodeval::app::WilliamsJob::new(
+        a.mesh.clone().expect("clap requires it"),
+        a.out.clone().expect("clap requires it"),
         goal,
-        views,
-        shading: match a.shading {
-            Shading::Auto => Shading::Gouraud,
-            Shading::Pbr => {
-                return Err(Error::Usage(
-                    "--method williams models Blinn–Phong shading (gouraud, phong, \
-                     normal-mapped, unlit); pbr is not one of them"
-                        .into(),
-                ));
-            }
-            s => s,
-        },
-        criterion: a.criterion.unwrap_or(Criterion::Perceptual),
-        size: a.size.unwrap_or(512),
-    })
+    );
+    job.views = views;
+    job.shading = match a.shading {
+        Shading::Auto => Shading::Gouraud,
+        Shading::Pbr => {
+            return Err(Error::Usage(
+                "--method williams models Blinn–Phong shading (gouraud, phong, normal-mapped, \
+                 unlit); pbr is not one of them"
+                    .into(),
+            ));
+        }
+        s => s,
+    };
+    job.criterion = a.criterion.unwrap_or(Criterion::Perceptual);
+    job.size = a.size.unwrap_or(512);
+    Ok(job)
 }
