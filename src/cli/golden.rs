@@ -51,21 +51,39 @@ pub(crate) fn run(a: GoldenArgs) -> Result<(), Error> {
     for m in &g.mismatches {
         note!("{m}");
     }
-    if g.mismatches.is_empty() {
+    let bless_all = format!("lodeval golden {} --bless", a.config.display());
+    // Missing goldens are one line, not one per image: a config without goldens yet is the
+    // usual first run. Said here beside the mismatches, or as the error when alone.
+    let missing = format!(
+        "MISSING {} of {} golden image(s) in {}: make them with {bless_all}",
+        g.missing,
+        g.checked,
+        dir.display()
+    );
+    if g.missing > 0 && !g.mismatches.is_empty() {
+        note!("{missing}");
+    }
+    if g.mismatches.is_empty() && g.missing == 0 {
         emit(&format!(
             "{} image(s) match their goldens in {}{report}\n",
             g.checked - g.blessed,
             dir.display()
         ))
+    } else if g.mismatches.is_empty() {
+        Err(Error::Regression(format!("{missing}{report}")))
     } else {
         Err(Error::Regression(format!(
-            "{} of {} image(s) differ from their goldens (pending -actual.png files and the \
-             report in {}{report}); to accept them: lodeval golden {} --bless, or one at a time \
-             with --bless ASSET/LOD/VIEW",
+            "{} of {} image(s) differ from their goldens{} (pending -actual.png files and the \
+             report in {}{report}); to accept them: {bless_all}, or one at a time with --bless \
+             ASSET/LOD/VIEW",
             g.mismatches.len(),
             g.checked,
+            if g.missing > 0 {
+                format!(" and {} are missing", g.missing)
+            } else {
+                String::new()
+            },
             out.join("golden").display(),
-            a.config.display()
         )))
     }
 }

@@ -41,7 +41,7 @@ use lodeval::Error;
     about = "Does a simplified mesh still look like the original, and from how far away can nobody tell them apart?",
     after_help = "Exit codes: 0 success · 1 the gate found a regression, a golden image mismatched \
         or diff --fail failed · 2 bad input or usage (one message naming the file and what to do) · \
-        3 internal error (a lodeval bug)\n\nStart with: lodeval eval configs/demo.toml"
+        3 internal error (a lodeval bug)\n\nStart with: lodeval eval configs/demo.toml\n(From a clone: `cargo install --path .` puts lodeval on your PATH; or run target/release/lodeval.)"
 )]
 pub(crate) struct Cli {
     /// Worker threads, 1 to 1024 (default: all cores). Results are identical for any value.

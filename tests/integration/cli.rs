@@ -485,7 +485,14 @@ fn completions_man_pages_and_help_with_examples_and_exit_codes() {
             "{cmd}: {}",
             r.stdout
         );
-    }
+    } // The top-level help and the README say how to get the `lodeval` command they type.
+    let r = lodeval(["--help"]);
+    assert!(r.stdout.contains("cargo install --path ."), "{}", r.stdout);
+    let readme = std::fs::read_to_string(crate::common::root().join("README.md")).unwrap();
+    assert!(
+        readme.contains("`cargo install --path .`") && readme.contains("target/release/lodeval"),
+        "the README does not say how to get the lodeval command"
+    );
 }
 
 #[test]

@@ -391,14 +391,23 @@ fn golden_images_compare_mismatch_bless_and_refuse_under_ci() {
     );
     let cfg = config(dir.path(), extra, &assets);
     let c = cfg.to_str().unwrap();
-    // No goldens yet: a mismatch, with the bless command.
+    // No goldens yet: exit 1, one line that says so with the bless command (not one line per
+    // image), no pending renders written, and the report says "missing", not "sizes differ".
     let r = lodeval_ci(&["golden", c], false);
     assert_eq!(r.code, 1, "{}", r.stderr);
-    assert!(r.stderr.contains("no golden image"), "{}", r.stderr);
     assert!(
-        r.stderr.contains(&format!("lodeval golden {c} --bless")),
+        r.stderr.contains("MISSING 12 of 12 golden image(s)")
+            && r.stderr.contains(&format!("lodeval golden {c} --bless")),
         "{}",
         r.stderr
+    );
+    assert!(r.stderr.lines().count() <= 3, "{}", r.stderr);
+    let pending = dir.path().join("out/golden/bunny3k");
+    assert!(!pending.exists(), "renders written for missing goldens");
+    let report = std::fs::read_to_string(dir.path().join("out/golden/report.html")).unwrap();
+    assert!(
+        report.contains("12 missing") && !report.contains("sizes differ"),
+        "{report}"
     );
     // Blessing is refused under CI, and writes nothing.
     let r = lodeval_ci(&["golden", c, "--bless"], true);

@@ -35,8 +35,10 @@ pub struct GoldenOutcome {
     pub checked: usize,
     /// Images blessed.
     pub blessed: usize,
-    /// One line per mismatch or missing golden.
+    /// One line per mismatch.
     pub mismatches: Vec<String>,
+    /// Images with no golden yet (not blessed, not written: `--bless` makes them).
+    pub missing: usize,
     /// Files written (blessed goldens, or actual/diff images of mismatches).
     pub written: Vec<PathBuf>,
     /// Every image and what became of it, for the report.
@@ -67,8 +69,9 @@ pub enum GoldenStatus {
     Match,
     /// Written as the new golden.
     Blessed,
-    /// Outside tolerance or missing: why, the actual render, and the heat map where the sizes
-    /// agree.
+    /// No golden yet (nothing written for it; `--bless` makes it).
+    Missing,
+    /// Outside tolerance: why, the actual render, and the heat map where the sizes agree.
     Mismatch {
         /// The reason.
         why: String,
@@ -206,6 +209,12 @@ pub fn run(plan: &Plan, bless: &Bless, ci: bool, out_dir: &Path) -> Result<Golde
                     outcome.images.push(record);
                     continue;
                 }
+                if !golden_path.exists() {
+                    outcome.missing += 1;
+                    record.status = GoldenStatus::Missing;
+                    outcome.images.push(record);
+                    continue;
+                }
                 let problem = compare(&flip, &golden_path, &actual, cfg)?;
                 if let Some((why, diff)) = problem {
                     let base = out_dir.join("golden").join(&rel);
@@ -254,9 +263,6 @@ fn compare(
     actual: &image::RgbImage,
     cfg: &crate::eval::config::Config,
 ) -> Result<Option<(String, Option<image::RgbImage>)>> {
-    if !golden_path.exists() {
-        return Ok(Some(("no golden image".into(), None)));
-    }
     let golden = LinearImage::load(golden_path)?;
     let (w, h) = (actual.width() as usize, actual.height() as usize);
     if (golden.width(), golden.height()) != (w, h) {

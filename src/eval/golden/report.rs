@@ -54,20 +54,31 @@ pub fn render(config: &Path, outcome: &GoldenOutcome) -> Result<String> {
         .iter()
         .filter(|i| matches!(i.status, GoldenStatus::Blessed))
         .count();
-    let matched = outcome.images.len() - failed.len() - blessed;
+    let missing = outcome.missing;
+    let matched = outcome.images.len() - failed.len() - blessed - missing;
     let mut h = String::new();
     let _ = write!(
         h,
         "<!DOCTYPE html><html><head><meta charset=\"utf-8\"><title>lodeval golden: {}</title>\
          <style>{STYLE}</style><script>{SCRIPT}</script></head><body>\
-         <h1>Golden images: {}</h1><p><b>{}</b> of {} image(s) differ, {} match, {} blessed.</p>",
+         <h1>Golden images: {}</h1><p><b>{}</b> of {} image(s) differ, {} match, {} blessed, \
+         {} missing.</p>",
         esc(&config.display().to_string()),
         esc(&config.display().to_string()),
         failed.len(),
         outcome.images.len(),
         matched,
-        blessed
+        blessed,
+        missing
     );
+    if missing > 0 {
+        let _ = write!(
+            h,
+            "<h2>Missing</h2><p>{missing} image(s) have no golden yet (nothing was written for \
+             them). To make them, run <code>lodeval golden {} --bless</code>.</p>",
+            esc(&config.display().to_string())
+        );
+    }
     if !failed.is_empty() {
         let _ = write!(
             h,
