@@ -507,6 +507,24 @@ mod tests {
     }
 
     #[test]
+    fn the_readme_lists_every_column_of_every_table() {
+        // The README's output table: the backticked column lists of each file's row, joined.
+        let readme = include_str!("../../README.md");
+        let documented = |file: &str| -> String {
+            let row = readme
+                .lines()
+                .find(|l| l.starts_with(&format!("| `{file}` |")))
+                .unwrap_or_else(|| panic!("the README has no row for {file}"));
+            let cell = row.splitn(3, '|').nth(2).unwrap_or("");
+            let cell = cell.split(" — ").next().unwrap_or(cell);
+            cell.split('`').skip(1).step_by(2).collect::<String>()
+        };
+        assert_eq!(documented("metrics.csv"), MetricRow::COLUMNS.join(","));
+        assert_eq!(documented("summary.csv"), SummaryRow::COLUMNS.join(","));
+        assert_eq!(documented("distances.csv"), DistanceRow::COLUMNS.join(","));
+    }
+
+    #[test]
     fn columns_match_serde_field_order() {
         fn header<T: Serialize + Columns>(row: T) {
             let mut w = ::csv::Writer::from_writer(Vec::new());
