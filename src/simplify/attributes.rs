@@ -241,12 +241,6 @@ impl AttributeQuadrics {
         }
     }
 
-    /// The summed quadric's minimum over the attributes with the position held at `x`, by the
-    /// Schur complement: with r = A_ax·x + b_a and A_aa = L·D·Lᵀ (L unit lower triangular),
-    /// min over a of Q(x, a) = xᵀA_xx·x + 2·b_x·x + c − rᵀA_aa⁻¹r, at a∗ = −A_aa⁻¹r. Where A_aa
-    /// is singular (a pivot below 1e-12 of its trace: too few faces) the attributes stay at
-    /// `keep`'s and the value is the quadric there.
-    // Dense linear algebra on fixed-size arrays: index loops read like the formulas.
     /// The sum of the wedges' packed quadrics (`S` values each).
     #[inline(always)]
     fn summed<const S: usize>(&self, wedges: &[u32]) -> [f64; S] {
@@ -276,6 +270,12 @@ impl AttributeQuadrics {
         q
     }
 
+    /// The summed quadric's minimum over the attributes with the position held at `x`, by the
+    /// Schur complement: with r = A_ax·x + b_a and A_aa = L·D·Lᵀ (L unit lower triangular),
+    /// min over a of Q(x, a) = xᵀA_xx·x + 2·b_x·x + c − rᵀA_aa⁻¹r, at a∗ = −A_aa⁻¹r. Where A_aa
+    /// is singular (a pivot below 1e-12 of its trace: too few faces) the attributes stay at
+    /// `keep`'s and the value is the quadric there.
+    // Dense linear algebra on fixed-size arrays: index loops read like the formulas.
     #[allow(clippy::needless_range_loop)]
     fn reduced<const N: usize, const M: usize, const S: usize, const WANT_ATTRS: bool>(
         &self,

@@ -627,14 +627,7 @@ fn entry(
     u: u32,
     v: u32,
 ) -> Option<Entry> {
-    let (a, b) = if adj.is_locked(u) || adj.class(u) > adj.class(v) {
-        (v, u)
-    } else {
-        (u, v)
-    };
-    if adj.is_locked(a) {
-        return None;
-    }
+    let (a, b) = adj.collapse_direction(u, v)?;
     Some(Entry {
         cost: (cost.cost(adj, a, b).max(0.0) as f32).to_bits(),
         a,

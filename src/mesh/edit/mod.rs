@@ -296,6 +296,18 @@ impl Adjacency {
             || (self.class[v as usize] == VertexClass::NonManifold && !self.non_manifold_collapses)
     }
 
+    /// Which way edge (u, v) collapses: (the vertex that moves, the one it moves onto). The
+    /// lower class collapses into the higher (a vertex that may move moves); `None` where
+    /// neither end may move.
+    pub fn collapse_direction(&self, u: u32, v: u32) -> Option<(u32, u32)> {
+        let (a, b) = if self.is_locked(u) || self.class(u) > self.class(v) {
+            (v, u)
+        } else {
+            (u, v)
+        };
+        (!self.is_locked(a)).then_some((a, b))
+    }
+
     /// A vertex's class.
     pub fn class(&self, v: u32) -> VertexClass {
         self.class[v as usize]

@@ -275,14 +275,7 @@ fn entry(
     u: u32,
     v: u32,
 ) -> Option<Entry> {
-    let (a, b) = if adj.is_locked(u) || adj.class(u) > adj.class(v) {
-        (v, u)
-    } else {
-        (u, v)
-    };
-    if adj.is_locked(a) {
-        return None;
-    }
+    let (a, b) = adj.collapse_direction(u, v)?;
     let (_, err) = cost.placement(adj, a, b);
     let estimate = silhouette.distance(err.max(0.0) / 3.0);
     Some(Entry {
