@@ -95,6 +95,56 @@ impl LinearImage {
     pub fn to_srgb8(&self) -> image::RgbImage {
         srgb8_image(self.width, self.height, &self.pixels)
     }
+
+    /// The object in a render on a plain background: the pixels that differ from the colour all
+    /// four corners share. `None` when the corners differ (not a render on a plain background) or
+    /// nothing differs.
+    pub fn silhouette(&self) -> Option<Silhouette> {
+        let (w, h) = (self.width, self.height);
+        let bg = self.pixels[0];
+        let corners = [w - 1, (h - 1) * w, h * w - 1];
+        if corners
+            .iter()
+            .any(|&i| (self.pixels[i] - bg).abs().max_element() > 1e-3)
+        {
+            return None;
+        }
+        let (mut n, mut sx, mut sy) = (0usize, 0f64, 0f64);
+        for (i, p) in self.pixels.iter().enumerate() {
+            if (*p - bg).abs().max_element() > 1e-3 {
+                n += 1;
+                sx += (i % w) as f64 + 0.5;
+                sy += (i / w) as f64 + 0.5;
+            }
+        }
+        (n > 0).then(|| Silhouette {
+            area: n,
+            centroid: (sx / n as f64, sy / n as f64),
+        })
+    }
+}
+
+/// Where an object sits in a render: [`LinearImage::silhouette`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Silhouette {
+    /// Pixels that are not background.
+    pub area: usize,
+    /// Their mean position (x, y), pixels from the top-left corner.
+    pub centroid: (f64, f64),
+}
+
+impl Silhouette {
+    /// Whether `other` is the same object framed differently: its centre moved by more than 2 %
+    /// of the object's size (√area), or its area changed by more than 10 % (a scale of ±5 %).
+    /// A simplification changes a silhouette by a few pixels along its outline; a render framed
+    /// by another bounding sphere moves and scales all of it. Returns the shift in pixels and
+    /// the area ratio when misframed.
+    pub fn misframed(&self, other: &Silhouette) -> Option<(f64, f64)> {
+        let size = (self.area as f64).sqrt();
+        let shift = (self.centroid.0 - other.centroid.0).hypot(self.centroid.1 - other.centroid.1);
+        let ratio = other.area as f64 / self.area as f64;
+        (shift > 0.02 * size || !(0.9..=1.1).contains(&ratio)).then_some((shift, ratio))
+    }
 }
 
 /// `width` × `height` linear RGB pixels (row-major) as 8-bit sRGB, RGB order, values outside

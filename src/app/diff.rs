@@ -86,6 +86,27 @@ pub struct DiffResult {
     /// FLIP on two EXR (linear, high-dynamic-range) images is HDR-FLIP: the exposures it used.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub exposures: Option<crate::metric::hdr_flip::Exposures>,
+    /// When both images are renders on a plain background and the object in the test image is
+    /// moved or scaled against the reference's ([`crate::image::Silhouette::misframed`]): what
+    /// moved, and how to render the two alike. The scores then measure the framing, not the LOD.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub framing: Option<String>,
+}
+
+/// The hint for two renders whose objects sit differently in the frame, if they do.
+pub fn framing_hint(
+    reference: &crate::image::LinearImage,
+    test: &crate::image::LinearImage,
+) -> Option<String> {
+    let (a, b) = (reference.silhouette()?, test.silhouette()?);
+    let (shift, ratio) = a.misframed(&b)?;
+    Some(format!(
+        "the object looks framed differently in the two images (its centre moved {shift:.1} px, \
+         its area is {:.0} % of the reference's), so the scores measure the framing as well as \
+         the shape. If each was rendered on its own, render the LOD with `lodeval render LOD \
+         --frame-like ORIGINAL` (or score both with `lodeval compare ORIGINAL LOD`)",
+        100.0 * ratio
+    ))
 }
 
 /// The worst pixel of a per-pixel map.
@@ -303,6 +324,7 @@ pub fn diff(
     let maps: Vec<PathBuf> = metrics.iter().filter_map(|&m| map_path(m)).collect();
     crate::io::check_not_inputs(&maps, &[reference.to_path_buf(), test.to_path_buf()])?;
     let (w, h) = (pair.a.width(), pair.a.height());
+    let framing = framing_hint(&pair.a, &pair.b);
     let mut out = Vec::new();
     for &metric in metrics {
         let mut r = DiffResult {
@@ -323,6 +345,7 @@ pub fn diff(
             worst_pixel: None,
             share_over: None,
             exposures: None,
+            framing: framing.clone(),
         };
         let mut values = None;
         let scored = score(&pair, &mut r).and_then(|v| {

@@ -54,6 +54,9 @@ pub struct RenderJob {
     /// Also write every view's camera here as JSON (eye, target, up, vertical field of view,
     /// near, far), to set the same view up in another renderer.
     pub cameras_json: Option<PathBuf>,
+    /// Frame the views by this mesh's bounding sphere instead of the rendered mesh's own, so a
+    /// LOD's renders line up pixel for pixel with its original's (`--frame-like ORIGINAL`).
+    pub frame_like: Option<PathBuf>,
 }
 
 impl RenderJob {
@@ -70,6 +73,7 @@ impl RenderJob {
             backend: crate::backend::Backend::Cpu,
             lighting: crate::scene::Lighting::default(),
             cameras_json: None,
+            frame_like: None,
         }
     }
 }
@@ -120,7 +124,14 @@ pub fn render(job: &RenderJob) -> Result<RenderReport> {
     let mut scene = RenderScene::of(mesh.clone());
     scene.light_with(&job.lighting);
     let aspect = job.settings.width as f32 / job.settings.height as f32;
-    let cameras = job.rig.cameras(&mesh, aspect);
+    let like = match &job.frame_like {
+        Some(path) => Some(mesh::load(path, &job.load)?),
+        None => None,
+    };
+    let cameras = match &like {
+        Some(like) => job.rig.cameras_framing(like.bounding_sphere(), aspect),
+        None => job.rig.cameras(&mesh, aspect),
+    };
     let engine = crate::backend::Engine::new(job.backend)?;
     let renderer = engine.scene(&scene)?;
     let warnings = mesh
@@ -141,7 +152,9 @@ pub fn render(job: &RenderJob) -> Result<RenderReport> {
         .flat_map(|p| std::iter::once(p.clone()).chain(job.exr.then(|| p.with_extension("exr"))))
         .collect();
     outputs.extend(job.cameras_json.clone());
-    crate::io::check_not_inputs(&outputs, &mesh.source().files)?;
+    let mut inputs = mesh.source().files.clone();
+    inputs.extend(like.iter().flat_map(|m| m.source().files.iter().cloned()));
+    crate::io::check_not_inputs(&outputs, &inputs)?;
     let mut written = Vec::new();
     if let Some(path) = &job.cameras_json {
         let json: Vec<CameraJson> = cameras

@@ -64,6 +64,22 @@ pub struct SimplifyRow {
     /// Menzel–Guthe's figures for this LOD and its run.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub menzel_guthe: Option<MenzelGutheRow>,
+    /// In a glTF chain: where this level takes over, as measured and as written.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub switch: Option<SwitchPoint>,
+}
+
+/// Where a level of a glTF chain written by `simplify` takes over from the finer one.
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct SwitchPoint {
+    /// Its level in the chain (`FILE#level`; 0 is the original).
+    pub level: usize,
+    /// The `MSFT_screencoverage` below which it is used (the finer level's value as written,
+    /// never more than a finer level's).
+    pub screen_coverage: f64,
+    /// The measured imperceptibility distance it comes from (criterion, distance, on-screen
+    /// diameter, Unity and Unreal values, bound), where one was measured.
+    pub measured: Option<crate::eval::tables::DistanceRow>,
 }
 
 /// What a Menzel–Guthe run did, reported with each of its LODs.
@@ -182,29 +198,14 @@ pub fn simplify(
     progress.finish();
     let lods = lods?;
     let seconds = start.elapsed().as_secs_f64();
-    if gltf {
-        // One asset: the original and every LOD, switching where each was measured invisible.
-        let original = std::sync::Arc::new(mesh.clone());
-        let named: Vec<(String, std::sync::Arc<Mesh>)> = lods
-            .iter()
-            .zip(&job.goals)
-            .map(|((l, _, _), g)| (goal_name(job.method, g), std::sync::Arc::new(l.clone())))
-            .collect();
-        let refs: Vec<(&str, std::sync::Arc<Mesh>)> =
-            named.iter().map(|(n, m)| (n.as_str(), m.clone())).collect();
-        let rows = crate::eval::export::measure(&original, &refs, job.meters_per_unit, &job.look)?;
-        let chain: Vec<(&str, &Mesh)> = named.iter().map(|(n, m)| (n.as_str(), &**m)).collect();
-        let (_, notes) = crate::eval::export::write_chain(
-            &job.out,
-            crate::eval::export::ORIGINAL,
-            &mesh,
-            &chain,
-            &rows,
-        )?;
-        warnings.extend(notes);
-    }
+    let lod_meshes: Vec<&Mesh> = lods.iter().map(|(l, _, _)| l).collect();
+    let switches = if gltf {
+        write_gltf_chain(job, &mesh, &lod_meshes, &mut warnings)?
+    } else {
+        vec![None; lods.len()]
+    };
     let mut rows = Vec::new();
-    for ((lod, error, mg), file) in lods.iter().zip(files) {
+    for (((lod, error, mg), file), switch) in lods.iter().zip(files).zip(switches) {
         if !gltf {
             for w in crate::mesh::write_obj::write(lod, &file)? {
                 if !warnings.contains(&w) {
@@ -212,6 +213,10 @@ pub fn simplify(
                 }
             }
         }
+        let file = match &switch {
+            Some(s) => PathBuf::from(format!("{}#{}", file.display(), s.level)),
+            None => file,
+        };
         rows.push(SimplifyRow {
             file,
             triangles: lod.triangle_count(),
@@ -219,9 +224,59 @@ pub fn simplify(
             simplifier_error: *error,
             seconds,
             menzel_guthe: mg.clone(),
+            switch,
         });
     }
     Ok(SimplifyReport { rows, warnings })
+}
+
+/// `-o CHAIN.glb|.gltf`: the original and every LOD as one asset, switching where each was
+/// measured invisible; returns each LOD's switch point (in `lods`' order).
+fn write_gltf_chain(
+    job: &SimplifyJob,
+    mesh: &Mesh,
+    lods: &[&Mesh],
+    warnings: &mut Vec<String>,
+) -> Result<Vec<Option<SwitchPoint>>> {
+    let original = std::sync::Arc::new(mesh.clone());
+    let named: Vec<(String, std::sync::Arc<Mesh>)> = lods
+        .iter()
+        .zip(&job.goals)
+        .map(|(l, g)| (goal_name(job.method, g), std::sync::Arc::new((*l).clone())))
+        .collect();
+    let refs: Vec<(&str, std::sync::Arc<Mesh>)> =
+        named.iter().map(|(n, m)| (n.as_str(), m.clone())).collect();
+    let rows = crate::eval::export::measure(&original, &refs, job.meters_per_unit, &job.look)?;
+    let chain: Vec<(&str, &Mesh)> = named.iter().map(|(n, m)| (n.as_str(), &**m)).collect();
+    let written = crate::eval::export::write_chain(
+        &job.out,
+        crate::eval::export::ORIGINAL,
+        mesh,
+        &chain,
+        &rows,
+    )?;
+    warnings.extend(written.warnings.iter().cloned());
+    Ok(named
+        .iter()
+        .map(|(name, _)| switch_point(&written, &rows, name))
+        .collect())
+}
+
+/// The switch point of the LOD named `name` in a chain `written` from distance `rows`.
+fn switch_point(
+    written: &crate::eval::export::ChainWritten,
+    rows: &[crate::eval::tables::DistanceRow],
+    name: &str,
+) -> Option<SwitchPoint> {
+    let level = written.levels.iter().position(|l| l == name)? + 1;
+    Some(SwitchPoint {
+        level,
+        screen_coverage: written.coverage[level - 1],
+        measured: rows
+            .iter()
+            .find(|r| r.lod == name && Some(&r.criterion) == written.criterion.as_ref())
+            .cloned(),
+    })
 }
 
 /// A LOD's name in a glTF chain: the method and the goal (`qem-r50`, `meshopt-t1000`).
@@ -367,6 +422,7 @@ pub fn simplify_williams(job: &WilliamsJob) -> Result<SimplifyReport> {
             simplifier_error: None,
             seconds,
             menzel_guthe: None,
+            switch: None,
         }],
         warnings,
     })

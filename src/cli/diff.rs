@@ -195,7 +195,10 @@ pub(crate) fn run(a: DiffArgs) -> Result<(), Error> {
     }
     print(&a, &all)?;
     let mut failed = Vec::new();
-    for (test, _, fail, warn) in &all {
+    for (test, results, fail, warn) in &all {
+        if let Some(hint) = results.first().and_then(|r| r.framing.as_ref()) {
+            note!("warning: {}: {hint}", test.display());
+        }
         if let Some(w) = warn
             && fail.is_none()
         {
@@ -338,7 +341,11 @@ fn line(r: &lodeval::app::DiffResult) -> String {
         ));
     }
     if let Some(w) = r.worst_pixel {
-        text.push_str(&format!("  worst pixel ({}, {}): {:.4}", w.x, w.y, w.value));
+        let what = r.metric.map_label().unwrap_or("value");
+        text.push_str(&format!(
+            "  worst pixel ({}, {}): {what} {:.4}",
+            w.x, w.y, w.value
+        ));
     }
     if let Some(s) = r.share_over {
         text.push_str(&format!("  {:.3} % over the pixel limit", 100.0 * s));

@@ -17,7 +17,7 @@ use super::print::warnings;
 
 #[derive(Args, Debug)]
 #[command(
-    after_help = "Example:\n  lodeval render reference/models/spot/spot_mtl.obj -o spot.png --view 3\n  lodeval render spot.obj --sheet -o sheet.png --size 256\n\nExit codes: 0 written · 2 bad input or usage · 3 internal error"
+    after_help = "Example:\n  lodeval render reference/models/spot/spot_mtl.obj -o spot.png --view 3\n  lodeval render spot.obj --sheet -o sheet.png --size 256\n  lodeval render spot-lod1.obj --frame-like spot.obj -o lod1.png   (aligned with spot's render, for diff)\n\nExit codes: 0 written · 2 bad input or usage · 3 internal error"
 )]
 pub(crate) struct RenderArgs {
     /// The mesh file.
@@ -67,6 +67,10 @@ pub(crate) struct RenderArgs {
     /// adapter) or auto (gpu when available).
     #[arg(long, value_enum, default_value_t = Backend::Cpu)]
     pub(crate) backend: Backend,
+    /// Frame the views like this mesh (the original, when rendering one of its LODs): by its
+    /// bounding sphere instead of the rendered mesh's own, so `diff` compares aligned images.
+    #[arg(long, value_name = "ORIGINAL")]
+    pub(crate) frame_like: Option<PathBuf>,
     #[command(flatten)]
     pub(crate) load: LoadArgs,
     #[command(flatten)]
@@ -104,6 +108,7 @@ impl RenderArgs {
         job.backend = self.backend;
         job.lighting = lighting;
         job.cameras_json = self.cameras;
+        job.frame_like = self.frame_like;
         Ok(job)
     }
 }

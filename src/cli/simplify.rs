@@ -185,8 +185,28 @@ pub(crate) fn run(a: SimplifyArgs, quiet: bool) -> Result<(), Error> {
             r.triangles,
             r.ratio,
         ));
+        if let Some(s) = &r.switch {
+            text.push_str(&switch_line(s));
+        }
     }
     emit(&text)
+}
+
+/// Where a chain level takes over, as the engines see it.
+fn switch_line(s: &lodeval::app::SwitchPoint) -> String {
+    let written = format!("MSFT_screencoverage {:.6}", s.screen_coverage);
+    match &s.measured {
+        Some(m) => format!(
+            "    switches in below {} px on screen ({} m away; Unity {:.4}, Unreal {:.4}; \
+             {written}) by {}\n",
+            m.diameter_text(),
+            m.distance_text(),
+            m.screen_height_fraction,
+            m.unreal_screen_size,
+            m.criterion
+        ),
+        None => format!("    not measured; {written}\n"),
+    }
 }
 
 /// `simplify --experiment CONFIG`: Menzel & Guthe's or Williams et al.'s reproduction.

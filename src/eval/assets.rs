@@ -67,11 +67,7 @@ pub fn build_lods(
             continue;
         }
         let (mesh, source, error) = match &lod.source {
-            LodSource::File(path) => (
-                mesh::load(path, &LoadOptions::default())?,
-                path.display().to_string(),
-                None,
-            ),
+            LodSource::File(path) => (load_lod(path)?, path.display().to_string(), None),
             LodSource::Generated {
                 method,
                 step,
@@ -112,4 +108,30 @@ pub fn build_lods(
         out.push((lod.name.clone(), mesh, info));
     }
     Ok(out)
+}
+
+/// A LOD file; a whole `MSFT_lod` chain named without a level is refused: as a LOD it is
+/// ambiguous, and loading it gives its level 0, the original itself, which would score as a
+/// perfect LOD.
+pub(crate) fn load_lod(path: &std::path::Path) -> Result<Mesh> {
+    let mesh = mesh::load(path, &LoadOptions::default())?;
+    match &mesh.source().lod_chain {
+        Some(chain) if chain.level.is_none() && chain.levels > 1 => {
+            Err(crate::error::Error::input(
+                path,
+                format!(
+                    "is an MSFT_lod chain of {} levels (#0, the finest, is the original's own \
+                 mesh), so which LOD to score is ambiguous",
+                    chain.levels
+                ),
+                format!(
+                    "name one level: {p}#1 (the first LOD) to {p}#{} (the coarsest); \
+                 `lodeval info {p}` lists them",
+                    chain.levels - 1,
+                    p = path.display()
+                ),
+            ))
+        }
+        _ => Ok(mesh),
+    }
 }

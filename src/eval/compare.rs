@@ -102,7 +102,7 @@ fn stem(p: &Path) -> String {
 fn plan(job: &CompareJob) -> Result<Plan> {
     let abs = |p: &Path| std::path::absolute(p).unwrap_or_else(|_| p.to_path_buf());
     for (what, path) in [("ORIGINAL", &job.original), ("LOD", &job.lod)] {
-        if !path.is_file() {
+        if !crate::mesh::split_level(path).0.is_file() {
             return Err(Error::input(
                 path,
                 format!("{what} is not there (or not a file)"),

@@ -4,8 +4,8 @@
 //! Geometry. The display is a window of `display_px` × `display_height_px` pixels, `display_width_m`
 //! wide, seen from `distance_m` (the default viewing conditions). A pixel at the centre subtends
 //! 1/k radians with k = distance_m · display_px / display_width_m, which also fixes the engine
-//! camera's vertical field of view (cot(fov/2) = 2k / height_px). An object whose bounding sphere
-//! has radius R (metres) at distance D from the eye projects to a disc of diameter
+//! camera's vertical field of view (cot(fov/2) = 2k / height_px). An object's size is its minimal
+//! enclosing sphere's (Welzl; [`crate::mesh::minimal_sphere`]): one whose sphere has radius R (metres) at distance D from the eye projects to a disc of diameter
 //! 2k·R/√(D² − R²) pixels; the inverse is D = R·√(1 + (2k/diameter)²).
 //!
 //! Method. For a candidate on-screen diameter the original and the LOD are rendered exactly as
@@ -30,11 +30,15 @@
 //! each view's probability, JND and FLIP), [`search_trace`] the worst view's values at every size
 //! the search probed, [`visibility_at`] the worst view's values at a distance in metres.
 //!
-//! Engine parameters at that distance (all from the same sphere, so they agree with each other):
-//! Unity's LODGroup relative screen height (diameter / screen height, `screen_height_fraction`),
-//! Unreal's `ScreenSize` (max(P₀₀, P₁₁)·R/D, as `ComputeBoundsScreenSize` computes it), the
-//! screen coverage of glTF's `MSFT_lod` (disc area / screen area), and meshoptimizer's error
-//! projected to pixels (error · k / D).
+//! Engine parameters at that distance, each from the bound that engine itself computes (not from
+//! lodeval's sphere; [`crate::mesh::EngineBounds`] cites where each is defined): Unity's LODGroup
+//! relative screen height (`LODGroup.size`, the box's largest side, over the frustum height:
+//! size / (2·D·tan(fov/2)), `screen_height_fraction`), Unreal's `ScreenSize` (max(P₀₀, P₁₁)·R/D
+//! with R the farthest vertex from the box centre, as `ComputeBoundsScreenSize` computes it), the
+//! screen coverage of glTF's `MSFT_lod` as Babylon.js evaluates it (π(R/D)² over the screen area
+//! at unit distance, R half the box diagonal), and meshoptimizer's error projected to pixels
+//! (error · k / D). Engines measure D to the box centre; the parameters are taken at D plus the
+//! box-to-sphere centre offset, so a switch there is never nearer than the measured distance.
 //!
 //! Caveat, stated rather than hidden: probabilities are taken as-is from one render per view;
 //! the VDP is not guaranteed monotone in size, so the bisection finds *a* crossing, the nearest to
@@ -91,15 +95,52 @@ impl Screen {
         r * (1.0 + (2.0 * self.k / diameter).powi(2)).sqrt()
     }
 
-    /// A distance row's engine parameters for radius `r` metres at `d` metres.
-    fn engine_params(&self, r: f64, d: f64) -> (f64, f64, f64) {
-        let diameter = self.diameter_px(r, d);
-        let p11 = 2.0 * self.k / self.height_px;
-        let p00 = 2.0 * self.k / self.width_px;
-        let unreal = p11.max(p00) * r / d;
-        let coverage =
-            std::f64::consts::PI * (diameter / 2.0).powi(2) / (self.width_px * self.height_px);
-        (diameter / self.height_px, unreal, coverage)
+    /// Each engine's LOD parameter when the viewer is `d` metres from the centre of lodeval's
+    /// sphere: (Unity's relative screen height, Unreal's `ScreenSize`, glTF `MSFT_screencoverage`),
+    /// each from the bound that engine uses ([`EngineScale`]). An engine measures its distance to
+    /// the box centre, up to `offset_m` nearer or farther than lodeval's depending on the
+    /// direction; the parameters are taken at `d + offset_m`, the far end, so that an engine
+    /// switching at them never shows the LOD nearer than `d`.
+    fn engine_params(&self, e: &EngineScale, d: f64) -> (f64, f64, f64) {
+        let d = d + e.offset_m;
+        // tan(fov_y / 2) of the display's camera: half the height over k.
+        let tan_half = self.height_px / (2.0 * self.k);
+        let unity = e.unity_size_m / (2.0 * d * tan_half);
+        // Unreal: ScreenMultiple = max(P₀₀, P₁₁)/2, radius · multiple / max(1 cm, D), times 2.
+        let (p00, p11) = (2.0 * self.k / self.width_px, 2.0 * self.k / self.height_px);
+        let unreal = p00.max(p11) * e.unreal_radius_m / d.max(0.01);
+        // Babylon: π (R / D)² over the screen's area at unit distance, 4 tan²(fov/2) · aspect.
+        let coverage = std::f64::consts::PI * (e.babylon_radius_m / d).powi(2)
+            / (4.0 * tan_half * tan_half * self.width_px / self.height_px);
+        (unity, unreal, coverage)
+    }
+}
+
+/// The original's bounds as each engine computes them ([`crate::mesh::EngineBounds`]), in metres,
+/// and the distance from their reference point (the box centre) to lodeval's sphere centre.
+#[derive(Debug, Clone, Copy)]
+pub struct EngineScale {
+    /// Unity `LODGroup.size`: the box's largest side.
+    pub unity_size_m: f64,
+    /// Unreal `SphereRadius`: the farthest vertex from the box centre.
+    pub unreal_radius_m: f64,
+    /// Babylon.js `BoundingSphere` radius: half the box diagonal.
+    pub babylon_radius_m: f64,
+    /// Box centre to the minimal sphere's centre.
+    pub offset_m: f64,
+}
+
+impl EngineScale {
+    /// From the original mesh and its metres per model unit.
+    pub fn new(mesh: &crate::mesh::Mesh, meters_per_unit: f64) -> EngineScale {
+        let b = mesh.engine_bounds();
+        let offset = b.center.distance(mesh.bounding_sphere().center);
+        EngineScale {
+            unity_size_m: b.unity_size as f64 * meters_per_unit,
+            unreal_radius_m: b.unreal_radius as f64 * meters_per_unit,
+            babylon_radius_m: b.babylon_radius as f64 * meters_per_unit,
+            offset_m: offset as f64 * meters_per_unit,
+        }
     }
 }
 
@@ -472,6 +513,7 @@ fn search_probing(
     // switch distance (up to the display's height) so that the gate's question has an answer.
     let r_m = r_units * job.meters_per_unit;
     let (min_d, max_d) = probe_range(&display, r_m, config, job.switch_m);
+    let engines = EngineScale::new(job.original.mesh(), job.meters_per_unit);
     let mut criteria: Vec<(String, Criterion)> = vec![(
         format!("vdp_p{}", config.probability.0),
         Box::new({
@@ -517,7 +559,7 @@ fn search_probing(
         let diameter = if lo == 0 { min_d } else { lo };
         let at = probe(diameter, true)?;
         let d_m = display.distance_for(r_m, diameter as f64);
-        let (fraction, unreal, coverage) = display.engine_params(r_m, d_m);
+        let (fraction, unreal, coverage) = display.engine_params(&engines, d_m);
         rows.push(DistanceRow {
             asset: job.names.0.to_string(),
             lod: job.names.1.to_string(),
@@ -711,9 +753,29 @@ mod tests {
             let dist = d.distance_for(0.5, diameter);
             assert!((d.diameter_px(0.5, dist) - diameter).abs() < 1e-9);
         }
-        // Far away the engine parameters agree: Unreal's screen size ≈ Unity's height fraction.
-        let (frac, unreal, cov) = d.engine_params(1.0, 100.0);
-        assert!((frac - unreal).abs() / frac < 1e-3, "{frac} {unreal}");
-        assert!(cov > 0.0 && cov < frac);
+    }
+
+    #[test]
+    fn engine_parameters_follow_each_engines_own_bound() {
+        // The default display: 3840 × 2160 px, k = 3840 px/rad, so tan(fov_y/2) = 2160/7680.
+        let d = Screen::new(&ViewingConfig::default());
+        // A unit cube (metres) 10 m away, its box centre 0.1 m from the sphere's: engines are
+        // evaluated at 10.1 m. Unity: side / (2 D tan) ; Unreal: (2k/h) · (√3/2) / D ;
+        // Babylon: π (√3/2 / D)² / (4 tan² · 16/9).
+        let e = EngineScale {
+            unity_size_m: 1.0,
+            unreal_radius_m: 3f64.sqrt() / 2.0,
+            babylon_radius_m: 3f64.sqrt() / 2.0,
+            offset_m: 0.1,
+        };
+        let (unity, unreal, coverage) = d.engine_params(&e, 10.0);
+        let tan = 2160.0 / 7680.0;
+        assert!((unity - 1.0 / (2.0 * 10.1 * tan)).abs() < 1e-12);
+        assert!((unreal - 7680.0 / 2160.0 * 0.8660254037844386 / 10.1).abs() < 1e-12);
+        let expected =
+            std::f64::consts::PI * (0.75 / (10.1f64 * 10.1)) / (4.0 * tan * tan * 3840.0 / 2160.0);
+        assert!((coverage - expected).abs() < 1e-12, "{coverage} {expected}");
+        // Unity's relative height is the side over the frustum's height there: 1 m of 5.68 m.
+        assert!((unity - 0.1760).abs() < 1e-4, "{unity}");
     }
 }

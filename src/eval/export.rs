@@ -67,15 +67,31 @@ pub fn coverage(rows: &[DistanceRow], asset: &str, lods: &[&str]) -> (Vec<f64>, 
     (out, warnings)
 }
 
+/// What [`write_chain`] wrote.
+#[derive(Debug, Clone)]
+pub struct ChainWritten {
+    /// Every file written.
+    pub files: Vec<PathBuf>,
+    /// The LODs' names in level order (level 1 first; level 0 is the original).
+    pub levels: Vec<String>,
+    /// `MSFT_screencoverage` as written, one per level including the original: level k is used
+    /// down to `coverage[k]`, so LOD level k takes over below `coverage[k - 1]`.
+    pub coverage: Vec<f64>,
+    /// The criterion the switch points come from.
+    pub criterion: Option<String>,
+    /// What could not be kept, and switch points that rest on a bound.
+    pub warnings: Vec<String>,
+}
+
 /// Write `original` (named `asset`) and its `lods` (name, mesh) as one glTF asset at `path`
-/// (`.glb` or `.gltf`) with switch points from `rows`; returns the files written and the warnings.
+/// (`.glb` or `.gltf`) with switch points from `rows`.
 pub fn write_chain(
     path: &Path,
     asset: &str,
     original: &Mesh,
     lods: &[(&str, &Mesh)],
     rows: &[DistanceRow],
-) -> Result<(Vec<PathBuf>, Vec<String>)> {
+) -> Result<ChainWritten> {
     let mut order: Vec<usize> = (0..lods.len()).collect();
     order.sort_by_key(|&i| std::cmp::Reverse(lods[i].1.triangle_count()));
     let names: Vec<&str> = order.iter().map(|&i| lods[i].0).collect();
@@ -85,7 +101,14 @@ pub fn write_chain(
     let mut written = crate::mesh::write_gltf::write_lod_chain(&levels, &coverage, path)?;
     let mut all = warnings;
     all.append(&mut written.warnings);
-    Ok((written.files, all))
+    let mine: Vec<DistanceRow> = rows.iter().filter(|r| r.asset == asset).cloned().collect();
+    Ok(ChainWritten {
+        files: written.files,
+        levels: names.iter().map(|n| n.to_string()).collect(),
+        coverage,
+        criterion: criterion(&mine),
+        warnings: all,
+    })
 }
 
 /// The imperceptibility distances of `lods` against `original` with `eval`'s defaults (the

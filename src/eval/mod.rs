@@ -314,22 +314,26 @@ fn copy_tree(from: &Path, to: &Path) -> Result<()> {
     Ok(())
 }
 
-/// The table `eval` prints: one line per LOD.
+/// The table `eval` prints: one line per LOD. What the user came for leads — below what
+/// on-screen size and beyond what distance the LOD cannot be told from the original — then the
+/// scores at the render size, labelled with it (a close-up, where every LOD is visible).
 pub fn summary_table(outcome: &Outcome) -> String {
     let r = &outcome.results;
+    let size = outcome.plan.config.render.size.0;
+    let (vdp, jnd) = (format!("vdp@{size}px"), format!("jnd@{size}px"));
     let mut s = format!(
-        "{:<12} {:<16} {:>9} {:>7} {:>9} {:>9} {:>8} {:>8} {:>8} {:>10} {:>10}  gate\n",
+        "{:<12} {:<16} {:>9} {:>7} {:>22} {:>22} {:>8} {:>8} {:>8} {:>10} {:>10}  gate\n",
         "asset",
         "lod",
         "triangles",
         "ratio",
+        "imperceptible_below_px",
+        "imperceptible_beyond_m",
         "flip",
         "flip_max",
         "psnr_min",
-        "vdp_max",
-        "jnd_max",
-        "visible_m",
-        "visible_px"
+        vdp,
+        jnd
     );
     let fmt = |v: Option<f64>, d: usize| match v {
         Some(x) if x.is_finite() => format!("{x:.d$}"),
@@ -345,26 +349,29 @@ pub fn summary_table(outcome: &Outcome) -> String {
             .iter()
             .any(|f| f.asset == l.asset && f.lod == l.lod);
         s.push_str(&format!(
-            "{:<12} {:<16} {:>9} {:>7.4} {:>9} {:>9} {:>8} {:>8} {:>8} {:>10} {:>10}  {}\n",
+            "{:<12} {:<16} {:>9} {:>7.4} {:>22} {:>22} {:>8} {:>8} {:>8} {:>10} {:>10}  {}\n",
             l.asset,
             l.lod,
             l.triangles,
             l.triangles as f64 / l.original_triangles.max(1) as f64,
+            px.unwrap_or_else(|| "-".into()),
+            dist.unwrap_or_else(|| "-".into()),
             fmt(hl.flip_mean, 4),
             fmt(hl.flip_worst, 4),
             fmt(hl.psnr_worst, 2),
             fmt(hl.vdp_worst, 3),
             fmt(hl.vdp_jnd_worst, 2),
-            dist.unwrap_or_else(|| "-".into()),
-            px.unwrap_or_else(|| "-".into()),
             if failed { "FAIL" } else { "pass" }
         ));
     }
-    s.push_str(
-        "flip: mean ꟻLIP over views (0 same … 1), flip_max: worst view · psnr_min: worst view, dB \
-         (8-bit sRGB) · vdp_max: detection probability, jnd_max: JND (1 = threshold), worst view · \
-         visible_m / visible_px: imperceptible beyond this distance (metres) / below this on-screen \
-         diameter (pixels) by the VDP, ≥/≤ where the search only bounds it\n",
-    );
+    s.push_str(&format!(
+        "imperceptible_below_px / imperceptible_beyond_m: the LOD cannot be told from the original \
+         (VDP) while the object is smaller on screen than this (its bounding sphere's diameter, \
+         display pixels) / farther than this (metres); ≥/≤ where the search only bounds it \
+         (distances.csv: diameter_px, imperceptible_beyond_m) · the rest at the {size} px \
+         close-up render, where every LOD is visible: flip: mean ꟻLIP over views (0 same … 1), \
+         flip_max: worst view · psnr_min: worst view, dB (8-bit sRGB) · {vdp}: detection \
+         probability, {jnd}: JND (1 = threshold), worst view\n"
+    ));
     s
 }

@@ -153,7 +153,7 @@ impl Plan {
         let base = config_dir(&self.config_path);
         for (asset, mesh) in written {
             let resolved = resolve(&base, mesh);
-            if resolved.exists() {
+            if crate::mesh::split_level(&resolved).0.exists() {
                 continue;
             }
             let quoted = format!("\"{}\"", mesh.display());

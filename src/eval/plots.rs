@@ -15,9 +15,9 @@ use std::path::Path;
 
 use super::config::ThresholdKey;
 use super::plan::Plan;
-use super::tables::Results;
+use super::tables::{DistanceBound, Results};
 use crate::error::Result;
-use crate::io::plot_png::{self, Chart, Line, Mark};
+use crate::io::plot_png::{self, Chart, Line, Mark, PointBound};
 use crate::metric::Metric;
 
 /// The metrics plotted, in this order, each with its catalogue title.
@@ -135,6 +135,12 @@ fn distance_chart(
                 .filter(|d| d.asset == asset && d.criterion == *c)
             {
                 line.points.push((d.triangles as f64, d.diameter_px));
+                // The diameter's bound runs opposite to the distance's.
+                line.bounds.push(match d.bound {
+                    DistanceBound::Measured => PointBound::Measured,
+                    DistanceBound::AtLeast => PointBound::AtMost,
+                    DistanceBound::AtMost => PointBound::AtLeast,
+                });
                 line.labels.push(format!(
                     "{} {} px · {} m",
                     d.lod,
@@ -146,13 +152,14 @@ fn distance_chart(
         })
         .collect();
     let chart = Chart {
-        title: format!("{} — where each LOD becomes imperceptible", asset),
+        title: format!("{} — below what size each LOD is imperceptible", asset),
         subtitle: format!(
-            "{}; smaller is better: the LOD can be used from this size down",
+            "{}; the LOD can replace the original at this on-screen size and below (higher is \
+             better)",
             view_conditions(plan)
         ),
         x_label: "triangles (log scale)".into(),
-        y_label: "on-screen diameter, px".into(),
+        y_label: "imperceptible below, px on screen".into(),
         lines,
         log_x: true,
         h_marks: Vec::new(),

@@ -1,8 +1,11 @@
-//! `report.html`: one self-contained page per run (no scripts, no network; the contact sheets are
-//! referenced relative to the report, inside the same output folder). Failures come first: the
-//! list of gate messages at the top, then assets with failures before the others. Per asset: a
-//! table of LODs (triangles, ratio, scores, switch distances), a plot of error against triangle
-//! count, and the contact sheets.
+//! `report.html`: one page per run (no scripts, no network; the contact sheets are the PNGs in
+//! `sheets/` beside it, referenced relatively, so keep the output folder together). The first
+//! screen answers what a user came for: below what on-screen size each LOD cannot be told from
+//! its original, and what that is in each engine's own LOD parameter (the "at a glance" table),
+//! after the gate's messages when it failed (assets with failures also come first below). Per asset: a table of LODs
+//! (where each can replace the original, then the scores at the evaluation's close-up render size,
+//! labelled as such — there every LOD is visible, which is not the question), a plot of error
+//! against triangle count, and the contact sheets.
 //!
 //! Decision: the plot is inline SVG rather than a raster image, so its text is real text (no
 //! bundled font needed), it scales, and it stays inside the one HTML file.
@@ -67,6 +70,8 @@ pub fn render(plan: &Plan, results: &Results, failures: &[Failure]) -> String {
         plan.config.render.shading.0.name(),
         plan.config.viewing.viewing().ppd()
     );
+    // A failing gate's messages come first (short, and what a CI run is opened for); then what
+    // everyone came for.
     if !failures.is_empty() {
         h.push_str("<h2>Failures</h2>\n<ul class=\"failures\">\n");
         for f in failures {
@@ -74,6 +79,7 @@ pub fn render(plan: &Plan, results: &Results, failures: &[Failure]) -> String {
         }
         h.push_str("</ul>\n");
     }
+    h.push_str(&at_a_glance(plan, results));
     // Assets with failures first, then config order.
     let mut assets: Vec<&super::plan::AssetPlan> = plan
         .assets
@@ -94,37 +100,7 @@ pub fn render(plan: &Plan, results: &Results, failures: &[Failure]) -> String {
             esc(&asset.name),
             esc(&asset.mesh.display().to_string())
         );
-        h.push_str("<table><tr><th>LOD</th><th>triangles</th><th>ratio</th><th>FLIP mean</th><th>FLIP worst view</th><th>SSIM worst</th><th>PSNR worst (dB)</th><th>VDP p worst</th><th>VDP JND worst</th><th>imperceptible beyond (m)</th><th>visible above (px)</th><th>Unity screen height</th><th>engine switch (m)</th><th>gate</th></tr>\n");
-        for l in &lods {
-            let hl = results.headline(&asset.name, &l.lod);
-            let dist: Option<&DistanceRow> = hl.distance.as_ref();
-            let bad = failing.contains(&(asset.name.as_str(), l.lod.as_str()));
-            let _ = writeln!(
-                h,
-                "<tr class=\"{}\"><td>{}</td><td>{}</td><td>{:.4}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td></tr>",
-                if bad { "fail" } else { "pass" },
-                esc(&l.lod),
-                l.triangles,
-                l.triangles as f64 / l.original_triangles.max(1) as f64,
-                num(hl.flip_mean, 4),
-                num(hl.flip_worst, 4),
-                num(hl.ssim_worst, 4),
-                num(hl.psnr_worst, 2),
-                num(hl.vdp_worst, 3),
-                num(hl.vdp_jnd_worst, 2),
-                dist.map_or_else(|| "–".to_string(), |d| esc(&d.distance_text())),
-                if dist.is_some_and(|d| !d.resolved) {
-                    " (bound)"
-                } else {
-                    ""
-                },
-                dist.map_or_else(|| "–".to_string(), |d| esc(&d.diameter_text())),
-                num(dist.map(|d| d.screen_height_fraction), 4),
-                num(l.switch_m, 2),
-                if bad { "FAIL" } else { "pass" }
-            );
-        }
-        h.push_str("</table>\n");
+        h.push_str(&lod_table(plan, results, &lods, &failing));
         h.push_str(&plot(results, &asset.name, original));
         h.push_str("<div class=\"sheets\">\n");
         for l in &lods {
@@ -140,6 +116,97 @@ pub fn render(plan: &Plan, results: &Results, failures: &[Failure]) -> String {
         h.push_str("</div>\n");
     }
     h.push_str("</body></html>\n");
+    h
+}
+
+/// The first screen: per LOD, below what on-screen size (and beyond what distance) it cannot be
+/// told from its original by the VDP, and that point in Unity's, Unreal's and glTF's terms.
+fn at_a_glance(plan: &Plan, results: &Results) -> String {
+    if results.distances.is_empty() {
+        return String::new();
+    }
+    let viewing = &plan.config.viewing;
+    let mut h = format!(
+        "<h2>At a glance: where each LOD can replace the original</h2>\n<p class=\"lead\">A LOD \
+         cannot be told from its original (the VDP's detection probability ≤ {}) while the object \
+         is <b>smaller on screen</b> than the size given — its bounding sphere's diameter in pixels \
+         of a {:.0} × {:.0} display — or <b>farther</b> than the distance. Switch to it there: the \
+         engine columns are that point in each engine's own LOD parameter, computed from the bound \
+         that engine uses (type them in as they are). ≥/≤ mark a bound of the search, not a \
+         measurement.</p>\n",
+        plan.config.distance.probability.0, viewing.display_px.0, viewing.display_height_px.0
+    );
+    h.push_str(
+        "<table class=\"glance\"><tr><th>asset</th><th>LOD</th><th>triangles</th>\
+         <th>imperceptible below (px on screen)</th><th>imperceptible beyond (m)</th>\
+         <th>Unity relative screen height</th><th>Unreal ScreenSize</th>\
+         <th>glTF MSFT_screencoverage</th></tr>\n",
+    );
+    for l in &results.lods {
+        let Some(d) = results.headline(&l.asset, &l.lod).distance else {
+            continue;
+        };
+        let _ = writeln!(
+            h,
+            "<tr><td>{}</td><td>{}</td><td>{}</td><td><b>{}</b></td><td>{}</td><td>{}</td><td>{}</td><td>{}</td></tr>",
+            esc(&l.asset),
+            esc(&l.lod),
+            l.triangles,
+            esc(&d.diameter_text()),
+            esc(&d.distance_text()),
+            num(Some(d.screen_height_fraction), 4),
+            num(Some(d.unreal_screen_size), 4),
+            num(Some(d.screen_coverage), 6)
+        );
+    }
+    h.push_str("</table>\n");
+    h
+}
+
+/// One asset's table of LODs: where each can replace the original, then its scores at the
+/// evaluation's render size (labelled with it).
+fn lod_table(
+    plan: &Plan,
+    results: &Results,
+    lods: &[&super::tables::LodInfo],
+    failing: &std::collections::BTreeSet<(&str, &str)>,
+) -> String {
+    let size = plan.config.render.size.0;
+    let mut h = format!(
+        "<table><tr><th colspan=\"3\"></th><th colspan=\"4\">where it can replace the original \
+         (VDP)</th><th colspan=\"6\">scores at the {size} × {size} px close-up render (the object \
+         fills the frame; every LOD is visible this close)</th><th></th></tr>\n<tr><th>LOD</th>\
+         <th>triangles</th><th>ratio</th><th>imperceptible below (px on screen)</th>\
+         <th>imperceptible beyond (m)</th><th>Unity relative screen height</th>\
+         <th>engine switch (m)</th><th>FLIP mean</th><th>FLIP worst view</th><th>SSIM worst</th>\
+         <th>PSNR worst (dB)</th><th>VDP p worst at {size} px</th><th>VDP JND worst at {size} px</th>\
+         <th>gate</th></tr>\n"
+    );
+    for l in lods {
+        let hl = results.headline(&l.asset, &l.lod);
+        let dist: Option<&DistanceRow> = hl.distance.as_ref();
+        let bad = failing.contains(&(l.asset.as_str(), l.lod.as_str()));
+        let _ = writeln!(
+            h,
+            "<tr class=\"{}\"><td>{}</td><td>{}</td><td>{:.4}</td><td><b>{}</b></td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td></tr>",
+            if bad { "fail" } else { "pass" },
+            esc(&l.lod),
+            l.triangles,
+            l.triangles as f64 / l.original_triangles.max(1) as f64,
+            dist.map_or_else(|| "–".to_string(), |d| esc(&d.diameter_text())),
+            dist.map_or_else(|| "–".to_string(), |d| esc(&d.distance_text())),
+            num(dist.map(|d| d.screen_height_fraction), 4),
+            num(l.switch_m, 2),
+            num(hl.flip_mean, 4),
+            num(hl.flip_worst, 4),
+            num(hl.ssim_worst, 4),
+            num(hl.psnr_worst, 2),
+            num(hl.vdp_worst, 3),
+            num(hl.vdp_jnd_worst, 2),
+            if bad { "FAIL" } else { "pass" }
+        );
+    }
+    h.push_str("</table>\n");
     h
 }
 
@@ -243,4 +310,4 @@ table{border-collapse:collapse;margin:1em 0}td,th{border:1px solid #ccc;padding:
 th{background:#eee}td:first-child{text-align:left}tr.fail td{background:#fde2e2}\
 p.fail{color:#a00}p.pass{color:#070}ul.failures li{color:#a00;font-family:monospace}\
 .sheets{display:flex;flex-wrap:wrap;gap:1em}figure{margin:0}figure img{max-width:400px;display:block}\
-svg.plot text{font-size:12px;fill:#333}";
+svg.plot text{font-size:12px;fill:#333}p.lead{max-width:60em}table.glance td:nth-child(2){text-align:left}td{white-space:nowrap}";

@@ -376,28 +376,30 @@ fn export_chain(
         .iter()
         .map(|l| (l.name.as_str(), l.scene.scene().mesh()))
         .collect();
-    let (_, notes) = super::export::write_chain(
+    let written = super::export::write_chain(
         &out_dir.join("export").join(format!("{asset}.{ext}")),
         asset,
         original,
         &chain,
         &results.distances,
     )?;
-    Ok(notes)
+    Ok(written.warnings)
 }
 
-/// The plan's mesh and LOD files as the config names them, also those of assets a shard ran
-/// none of the cases of.
+/// The plan's mesh and LOD files as the config names them (a chain level `FILE#K` as its file),
+/// also those of assets a shard ran none of the cases of.
 fn mesh_files(plan: &Plan) -> Vec<PathBuf> {
     let mut files = Vec::new();
     for asset in &plan.assets {
-        files.push(asset.mesh.clone());
+        files.push(crate::mesh::split_level(&asset.mesh).0);
         for l in &asset.lods {
             if let LodSource::File(p) = &l.source {
-                files.push(p.clone());
+                files.push(crate::mesh::split_level(p).0);
             }
         }
     }
+    // A chain's levels are one file.
+    files.dedup();
     files
 }
 
@@ -647,7 +649,13 @@ fn write_heat_map(
     metric: Metric,
     map: &crate::image::ErrorMap,
 ) -> Result<()> {
-    let img = colormap::heat_map(&map.values, map.width, map.height, (map.height / 32).max(4));
+    let legend = if metric == Metric::Vdp {
+        &colormap::JND_LEGEND[..]
+    } else {
+        &colormap::UNIT_LEGEND[..]
+    };
+    let strip = (map.height / 32).max(4);
+    let img = colormap::heat_map_with(&map.values, map.width, map.height, strip, legend);
     crate::io::write_image(
         &heat_map_path(out, asset, lod, view, metric),
         &image::DynamicImage::ImageRgb8(img),

@@ -12,7 +12,7 @@ use super::tables::round7;
 use crate::error::Result;
 use crate::metric::flip::{Flip, FlipPrepared};
 use crate::metric::vdp::{Display, Vdp, VdpPrepared};
-use crate::metric::{ErrorMap, LinearImage, Metric, mse, pool, ssim};
+use crate::metric::{ErrorMap, LinearImage, Metric, colormap, mse, pool, ssim};
 use crate::scene::Viewing;
 
 /// The configured metrics at one viewing condition.
@@ -177,7 +177,13 @@ impl Scorer {
                         .compare_prepared(prepared, &self.vdp.prepare(test))?;
                     out.values.push((Metric::Vdp, round7(s.probability)));
                     out.values.push((Metric::VdpJnd, round7(s.jnd)));
-                    out.maps.push((Metric::Vdp, s.map));
+                    // Drawn on the JND scale: at a close-up render the probability is 1
+                    // almost everywhere on the object, a solid blob.
+                    let mut map = s.jnd_map;
+                    map.values
+                        .iter_mut()
+                        .for_each(|v| *v = colormap::jnd_scale(*v));
+                    out.maps.push((Metric::Vdp, map));
                 }
             }
         }

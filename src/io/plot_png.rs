@@ -28,6 +28,22 @@ pub struct Line {
     pub labels: Vec<String>,
     /// Dashed instead of solid.
     pub dashed: bool,
+    /// Which points are bounds rather than measurements, in the order of `points` (empty: all
+    /// measured). A bound is drawn as an open ring with an arrow towards where the true value
+    /// lies, joined to its neighbours by a dotted segment.
+    pub bounds: Vec<PointBound>,
+}
+
+/// What a plotted point is.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum PointBound {
+    /// A measured value.
+    #[default]
+    Measured,
+    /// The true value is at most this (arrow down).
+    AtMost,
+    /// The true value is at least this (arrow up).
+    AtLeast,
 }
 
 /// A reference line across the plot (`Chart::h_marks`: at a y value) or upright (`v_marks`: at an
@@ -97,6 +113,7 @@ impl Chart {
                     points: points.clone(),
                     labels: Vec::new(),
                     dashed: *dashed,
+                    bounds: Vec::new(),
                 })
                 .collect(),
             log_x,
@@ -160,7 +177,7 @@ pub fn render(chart: &Chart) -> Pixmap {
 
 /// A series' points that can be drawn (finite, positive x on a log axis), sorted by x, each with
 /// its label.
-type Points<'a> = Vec<(f64, f64, Option<&'a str>)>;
+type Points<'a> = Vec<(f64, f64, Option<&'a str>, PointBound)>;
 
 /// Every line's drawable points.
 fn plotted_points(chart: &Chart) -> Vec<Points<'_>> {
@@ -173,7 +190,10 @@ fn plotted_points(chart: &Chart) -> Vec<Points<'_>> {
                 .iter()
                 .enumerate()
                 .filter(|(_, p)| p.0.is_finite() && p.1.is_finite() && (!chart.log_x || p.0 > 0.0))
-                .map(|(i, p)| (p.0, p.1, l.labels.get(i).map(String::as_str)))
+                .map(|(i, p)| {
+                    let bound = l.bounds.get(i).copied().unwrap_or_default();
+                    (p.0, p.1, l.labels.get(i).map(String::as_str), bound)
+                })
                 .collect();
             pts.sort_by(|a, b| a.0.total_cmp(&b.0));
             pts
@@ -304,47 +324,150 @@ fn draw_series(pm: &mut Pixmap, area: &Area, chart: &Chart, lines: &[Points<'_>]
         1
     };
     let pclip = Rect::from_ltrb(x0 - 6.0, y0 - 6.0, x1 + 6.0, y1 + 6.0).expect("non-empty");
+    let mut labels = Labels::new(area);
     for (k, (line, pts)) in chart.lines.iter().zip(lines).enumerate() {
         let color = hex(COLORS[(k / share) % COLORS.len()]);
         let ink = paint(color);
-        if pts.len() > 1 {
+        // Segment by segment: dotted where either end is a bound, not a measurement.
+        for w in pts.windows(2) {
+            let bound = w[0].3 != PointBound::Measured || w[1].3 != PointBound::Measured;
+            let style = if bound {
+                dotted(2.0)
+            } else {
+                stroke(2.0, line.dashed)
+            };
+            let (a, b) = (
+                (area.px(w[0].0), area.py(w[0].1)),
+                (area.px(w[1].0), area.py(w[1].1)),
+            );
             let mut pb = PathBuilder::new();
-            pb.move_to(area.px(pts[0].0), area.py(pts[0].1));
-            for p in &pts[1..] {
-                pb.line_to(area.px(p.0), area.py(p.1));
-            }
+            pb.move_to(a.0, a.1);
+            pb.line_to(b.0, b.1);
             if let Some(path) = pb.finish() {
-                pm.stroke_path(
-                    &path,
-                    &ink,
-                    &stroke(2.0, line.dashed),
-                    Transform::identity(),
-                    None,
-                );
+                pm.stroke_path(&path, &ink, &style, Transform::identity(), None);
             }
         }
-        for &(x, y, text) in pts {
+        for &(x, y, text, bound) in pts {
             let (sx, sy) = (area.px(x), area.py(y));
             if sx < pclip.left() || sx > pclip.right() || sy < pclip.top() || sy > pclip.bottom() {
                 continue;
             }
             // A dense curve's dots would hide its line.
-            if pts.len() <= MAX_DOTS
-                && let Some(dot) = PathBuilder::from_circle(sx, sy, 3.5)
-            {
-                pm.fill_path(&dot, &ink, FillRule::Winding, Transform::identity(), None);
+            if pts.len() <= MAX_DOTS || bound != PointBound::Measured {
+                draw_point(pm, (sx, sy), &ink, bound);
             }
             if let Some(text) = text.filter(|t| !t.is_empty()) {
-                // Even series label above their points, odd ones below, so two series' labels
-                // at the same x do not print over each other.
-                let dy = if k % 2 == 0 { -6.0 } else { 15.0 };
-                label::draw_pixmap(pm, text, sx + 6.0, sy + dy, Style::new(11.0, color));
+                let (lx, ly) = labels.place(text, (sx, sy), k % 2 == 0);
+                // A label pushed away from its point gets a leader line back to it.
+                if (ly - sy).abs() > 20.0 {
+                    let end = if lx > sx { lx - 1.0 } else { lx + 4.0 };
+                    stroke_line(pm, (sx, sy), (end, ly - 4.0), &ink, 0.6, false);
+                }
+                label::draw_pixmap(pm, text, lx, ly, Style::new(11.0, color));
             }
         }
         let ly = y0 + 8.0 + 20.0 * k as f32;
         stroke_line(pm, (x1 + 12.0, ly), (x1 + 40.0, ly), &ink, 2.0, line.dashed);
         label::draw_pixmap(pm, &line.name, x1 + 46.0, ly + 4.0, Style::new(12.0, INK));
     }
+    if lines.iter().flatten().any(|p| p.3 != PointBound::Measured) {
+        let ly = y0 + 8.0 + 20.0 * chart.lines.len() as f32 + 6.0;
+        draw_point(pm, (x1 + 26.0, ly), &paint(INK), PointBound::AtMost);
+        let note = "bound: true value past arrow";
+        label::draw_pixmap(pm, note, x1 + 46.0, ly + 4.0, Style::new(11.0, INK));
+    }
+}
+
+/// A point's marker: a dot for a measurement, an open ring with an arrow (down for "at most", up
+/// for "at least") for a bound.
+fn draw_point(pm: &mut Pixmap, (sx, sy): (f32, f32), ink: &Paint<'_>, bound: PointBound) {
+    let dir = match bound {
+        PointBound::Measured => {
+            if let Some(dot) = PathBuilder::from_circle(sx, sy, 3.5) {
+                pm.fill_path(&dot, ink, FillRule::Winding, Transform::identity(), None);
+            }
+            return;
+        }
+        PointBound::AtMost => 1.0,
+        PointBound::AtLeast => -1.0,
+    };
+    if let Some(ring) = PathBuilder::from_circle(sx, sy, 4.5) {
+        pm.stroke_path(&ring, ink, &stroke(1.5, false), Transform::identity(), None);
+    }
+    stroke_line(
+        pm,
+        (sx, sy + dir * 5.0),
+        (sx, sy + dir * 16.0),
+        ink,
+        1.5,
+        false,
+    );
+    let mut head = PathBuilder::new();
+    head.move_to(sx - 4.0, sy + dir * 12.0);
+    head.line_to(sx, sy + dir * 17.0);
+    head.line_to(sx + 4.0, sy + dir * 12.0);
+    if let Some(path) = head.finish() {
+        pm.stroke_path(&path, ink, &stroke(1.5, false), Transform::identity(), None);
+    }
+}
+
+/// A dotted stroke (bounds' segments).
+fn dotted(width: f32) -> Stroke {
+    let mut s = stroke(width, false);
+    s.dash = tiny_skia::StrokeDash::new(vec![2.0, 4.0], 0.0);
+    s
+}
+
+/// Point labels placed so that none overlaps another or leaves the plot: each tries spots around
+/// its point, nearest first, and takes the first free one (the preferred side first: above for
+/// even series, below for odd ones).
+struct Labels {
+    placed: Vec<Rect>,
+    bounds: (f32, f32, f32, f32),
+}
+
+impl Labels {
+    fn new(area: &Area) -> Labels {
+        Labels {
+            placed: Vec::new(),
+            bounds: (area.x0, area.y0, area.x1, area.y1),
+        }
+    }
+
+    /// The baseline origin for `text` beside the point at `at`.
+    fn place(&mut self, text: &str, at: (f32, f32), above: bool) -> (f32, f32) {
+        let (w, h) = (label::text_width(text, 11.0), 11.0);
+        let (bx0, by0, bx1, by1) = self.bounds;
+        let mut candidates = Vec::new();
+        for step in 0..24 {
+            let lift = 14.0 * step as f32;
+            let (up, down) = ((6.0, -6.0 - lift), (6.0, 15.0 + lift));
+            let (first, second) = if above { (up, down) } else { (down, up) };
+            candidates.extend([first, second, (-6.0 - w, first.1), (-6.0 - w, second.1)]);
+        }
+        let rect = |(dx, dy): (f32, f32)| {
+            let (x, y) = (at.0 + dx, at.1 + dy);
+            Rect::from_xywh(x, y - h, w, h + 2.0)
+        };
+        let free = candidates.iter().copied().find(|&c| {
+            rect(c).is_some_and(|r| {
+                r.left() >= bx0
+                    && r.right() <= bx1 + 40.0
+                    && r.top() >= by0
+                    && r.bottom() <= by1
+                    && !self.placed.iter().any(|p| overlaps(p, &r))
+            })
+        });
+        let chosen = free.unwrap_or(candidates[0]);
+        if let Some(r) = rect(chosen) {
+            self.placed.push(r);
+        }
+        (at.0 + chosen.0, at.1 + chosen.1)
+    }
+}
+
+fn overlaps(a: &Rect, b: &Rect) -> bool {
+    a.left() < b.right() && b.left() < a.right() && a.top() < b.bottom() && b.top() < a.bottom()
 }
 
 /// One axis: its data range and how values map onto it.
@@ -540,6 +663,7 @@ mod tests {
                 points: vec![(700.0, 0.08), (7_000.0, 0.02), (35_000.0, 0.004)],
                 labels: vec!["r01".into(), "r10".into(), "r50".into()],
                 dashed: false,
+                bounds: Vec::new(),
             }],
             log_x: true,
             h_marks: vec![Mark {
@@ -557,6 +681,43 @@ mod tests {
     fn rgb(pm: &Pixmap, x: f32, y: f32) -> [u8; 3] {
         let p = pm.pixel(x.round() as u32, y.round() as u32).unwrap();
         [p.red(), p.green(), p.blue()]
+    }
+
+    #[test]
+    fn point_labels_never_overlap_and_stay_inside_the_plot() {
+        // Two series of five points crowded into one corner: every label finds a free spot.
+        let mut c = chart();
+        c.lines = (0..2)
+            .map(|k| Line {
+                name: format!("s{k}"),
+                points: (0..5)
+                    .map(|i| (1000.0 + 150.0 * i as f64, 0.001 * (i + k) as f64))
+                    .collect(),
+                labels: (0..5)
+                    .map(|i| format!("meshopt-r{i} {k} px · 12.34 m"))
+                    .collect(),
+                bounds: vec![PointBound::AtMost],
+                ..Line::default()
+            })
+            .collect();
+        let pts = plotted_points(&c);
+        let area = Area::new(&c, &pts);
+        let mut labels = Labels::new(&area);
+        for (k, line) in pts.iter().enumerate() {
+            for p in line {
+                labels.place(p.2.unwrap(), (area.px(p.0), area.py(p.1)), k % 2 == 0);
+            }
+        }
+        assert_eq!(labels.placed.len(), 10);
+        for (i, a) in labels.placed.iter().enumerate() {
+            assert!(a.top() >= area.y0 && a.bottom() <= area.y1, "{a:?}");
+            for b in &labels.placed[i + 1..] {
+                assert!(!overlaps(a, b), "{a:?} {b:?}");
+            }
+        }
+        // The first point of each series is a bound: drawn, with the bound's legend entry.
+        let png = encode(&c).unwrap();
+        assert!(!png.is_empty());
     }
 
     #[test]

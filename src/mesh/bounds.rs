@@ -1,8 +1,7 @@
-//! Bounding volumes: axis-aligned box and bounding sphere.
-//!
-//! Based on: Jack Ritter. An Efficient Bounding Sphere. Graphics Gems 1990 — the two-pass
-//! approximation (about 5–20 % larger than the minimal sphere), then a final pass that grows the
-//! sphere until every vertex is inside even after floating-point rounding.
+//! Bounding volumes: the axis-aligned box, the bounding sphere lodeval frames and sizes objects by
+//! (the minimal enclosing sphere, computed in `enclosing.rs`), and the bounds game engines measure their
+//! LOD switch parameters by ([`EngineBounds`]: Unity, Unreal, glTF `MSFT_lod` as Babylon.js reads
+//! it), each as that engine's source defines it.
 
 use glam::Vec3;
 
@@ -46,41 +45,42 @@ pub struct Sphere {
     pub radius: f32,
 }
 
-impl Sphere {
-    /// Ritter's bounding sphere of a non-empty point set.
-    pub fn ritter(points: &[Vec3]) -> Sphere {
-        // Pass 1: from an arbitrary point find the farthest x, then from x the farthest y.
-        let farthest = |from: Vec3| {
-            points
-                .iter()
-                .copied()
-                .fold((from, -1.0f32), |(best, d), p| {
-                    let dp = p.distance_squared(from);
-                    if dp > d { (p, dp) } else { (best, d) }
-                })
-                .0
-        };
-        let x = farthest(points[0]);
-        let y = farthest(x);
-        let mut center = (x + y) * 0.5;
-        let mut radius = x.distance(y) * 0.5;
-        // Pass 2: grow the sphere to include every point outside it.
-        for &p in points {
-            let d = p.distance(center);
-            if d > radius {
-                let new_radius = (radius + d) * 0.5;
-                center += (p - center) * ((new_radius - radius) / d);
-                radius = new_radius;
-            }
-        }
-        // Pass 3: rounding can leave points a few ulps outside; make containment exact.
-        let max_d = points
-            .iter()
-            .map(|p| p.distance(center))
-            .fold(0.0f32, f32::max);
-        Sphere {
+/// The bound each engine computes its LOD switch parameter from, for the same vertices. Engines
+/// do not use the minimal sphere lodeval frames by; an engine value computed from lodeval's
+/// sphere would put the switch somewhere else than the engine does.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+pub struct EngineBounds {
+    /// The box centre: the point every engine below measures the camera distance to (Unity's
+    /// `LODGroup.localReferencePoint` after `RecalculateBounds`, Unreal's `Bounds.Origin`,
+    /// Babylon's `boundingSphere.centerWorld`).
+    pub center: Vec3,
+    /// Unity `LODGroup.size`: the largest side of the box (`RecalculateBounds`). Relative screen
+    /// height = size / (2 · D · tan(fov/2)) (`LODUtility.DistanceToRelativeHeight`).
+    pub unity_size: f32,
+    /// Unreal `FBoxSphereBounds::SphereRadius` of a mesh built from its vertices: the farthest
+    /// vertex from the box centre (`FBoxSphereBounds(const FVector*, uint32)`). `ScreenSize` =
+    /// 2 · max(P₀₀, P₁₁)/2 · R / D (`ComputeBoundsScreenSize`).
+    pub unreal_radius: f32,
+    /// glTF `MSFT_screencoverage` as Babylon.js, the extension's reference loader, evaluates it:
+    /// its `BoundingSphere` from the box is centred on it with half the box diagonal as radius,
+    /// and coverage = π (R / D)² / (4 tan²(fov/2) · aspect) (`Mesh.getLOD`, `Camera.screenArea`).
+    pub babylon_radius: f32,
+}
+
+impl EngineBounds {
+    /// The engines' bounds of a non-empty point set.
+    pub fn of(points: &[Vec3]) -> EngineBounds {
+        let aabb = Aabb::of(points);
+        let center = aabb.center();
+        let size = aabb.max - aabb.min;
+        EngineBounds {
             center,
-            radius: radius.max(max_d) * (1.0 + 4.0 * f32::EPSILON),
+            unity_size: size.max_element(),
+            unreal_radius: points
+                .iter()
+                .map(|p| p.distance(center))
+                .fold(0.0f32, f32::max),
+            babylon_radius: aabb.diagonal() * 0.5,
         }
     }
 }
@@ -90,15 +90,37 @@ mod tests {
     use super::*;
 
     #[test]
-    fn sphere_contains_every_point_and_is_near_minimal_for_a_cube() {
-        // The 8 corners of a unit cube: the minimal sphere has radius sqrt(3)/2.
-        let pts: Vec<Vec3> = (0..8)
-            .map(|i| Vec3::new((i & 1) as f32, ((i >> 1) & 1) as f32, ((i >> 2) & 1) as f32))
+    fn engine_bounds_of_a_box_with_one_far_corner() {
+        // A 4 × 2 × 1 box's corners: Unity's size is the largest side, Babylon's radius half the
+        // diagonal; Unreal's radius is the farthest corner from the centre (the same here).
+        let mut pts: Vec<Vec3> = (0..8)
+            .map(|i| {
+                Vec3::new(
+                    (i & 1) as f32 * 4.0,
+                    ((i >> 1) & 1) as f32 * 2.0,
+                    ((i >> 2) & 1) as f32,
+                )
+            })
             .collect();
-        let s = Sphere::ritter(&pts);
-        assert!(pts.iter().all(|p| p.distance(s.center) <= s.radius));
-        assert!(s.radius < 3f32.sqrt() / 2.0 * 1.2);
-        let b = Aabb::of(&pts);
-        assert_eq!((b.min, b.max), (Vec3::ZERO, Vec3::ONE));
+        let half_diagonal = (16.0f32 + 4.0 + 1.0).sqrt() / 2.0;
+        let b = EngineBounds::of(&pts);
+        assert_eq!(b.center, Vec3::new(2.0, 1.0, 0.5));
+        assert_eq!(b.unity_size, 4.0);
+        assert!((b.babylon_radius - half_diagonal).abs() < 1e-6);
+        assert!((b.unreal_radius - half_diagonal).abs() < 1e-6);
+        // An octahedron's tips inside that box: Unreal's radius is the farthest vertex, smaller.
+        pts = vec![
+            Vec3::new(0.0, 1.0, 0.5),
+            Vec3::new(4.0, 1.0, 0.5),
+            Vec3::new(2.0, 0.0, 0.5),
+            Vec3::new(2.0, 2.0, 0.5),
+            Vec3::new(2.0, 1.0, 0.0),
+            Vec3::new(2.0, 1.0, 1.0),
+        ];
+        let b = EngineBounds::of(&pts);
+        assert_eq!(b.unreal_radius, 2.0);
+        assert!((b.babylon_radius - half_diagonal).abs() < 1e-6);
+        let s = super::super::enclosing::minimal_sphere(&pts);
+        assert!((s.radius - 2.0).abs() < 1e-5);
     }
 }

@@ -23,6 +23,7 @@
 
 mod bounds;
 pub mod edit;
+mod enclosing;
 mod gltf;
 mod gltf_material;
 mod incidence;
@@ -50,7 +51,8 @@ use glam::{Vec2, Vec3};
 
 use crate::error::{Error, Result};
 
-pub use bounds::{Aabb, Sphere};
+pub use bounds::{Aabb, EngineBounds, Sphere};
+pub use enclosing::minimal_sphere;
 pub use material::{
     AlphaMode, Filter, Material, Model, Sampler, TextureSlot, TextureTransform, Wrap,
 };
@@ -194,6 +196,39 @@ pub struct Source {
     /// The scene nodes whose meshes were merged into this one (glTF), with the world transforms
     /// the loader applied to their vertices; empty for formats without nodes.
     pub nodes: Vec<SourceNode>,
+    /// glTF: the `MSFT_lod` chain the file holds, if any, and which level was loaded.
+    pub lod_chain: Option<LodChain>,
+}
+
+/// A glTF node's `MSFT_lod` chain: level 0 is the node's own mesh (the finest), levels 1 … N−1
+/// the nodes its `ids` list, coarser in turn. `FILE.glb#K` loads level K.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct LodChain {
+    /// The node that carries the extension (its name, or `node N`).
+    pub node: String,
+    /// Levels, the node's own included.
+    pub levels: usize,
+    /// `extras.MSFT_screencoverage`, one value per level, where the file gives it.
+    pub coverage: Option<Vec<f64>>,
+    /// The level loaded: `Some(K)` for `FILE#K`, `None` when the path named no level (level 0
+    /// was loaded).
+    pub level: Option<usize>,
+}
+
+/// `FILE.glb#K` or `FILE.gltf#K`: the file and level K of its `MSFT_lod` chain. A path that
+/// exists as written is a file, '#' and all; anything else is the path itself and no level.
+pub fn split_level(path: &Path) -> (PathBuf, Option<usize>) {
+    if path.exists() {
+        return (path.to_path_buf(), None);
+    }
+    let text = path.to_string_lossy();
+    if let Some((file, level)) = text.rsplit_once('#')
+        && let Ok(level) = level.parse::<usize>()
+        && matches!(Format::from_path(Path::new(file)), Ok(Format::Gltf))
+    {
+        return (PathBuf::from(file), Some(level));
+    }
+    (path.to_path_buf(), None)
 }
 
 /// A glTF node whose mesh the loader merged, and the world transform it applied.
@@ -261,6 +296,7 @@ pub struct Mesh {
     unreferenced_removed: usize,
     aabb: Aabb,
     sphere: Sphere,
+    engine_bounds: EngineBounds,
     source: Source,
     warnings: Vec<String>,
 }
@@ -288,7 +324,8 @@ impl Mesh {
         // Weld by exact position so simplifiers can see through seams.
         let (weld, welded_count) = weld::by_position(&data.positions);
         let aabb = Aabb::of(&data.positions);
-        let sphere = Sphere::ritter(&data.positions);
+        let sphere = enclosing::minimal_sphere(&data.positions);
+        let engine_bounds = EngineBounds::of(&data.positions);
         Ok(Mesh {
             positions: data.positions,
             normals,
@@ -306,6 +343,7 @@ impl Mesh {
             unreferenced_removed,
             aabb,
             sphere,
+            engine_bounds,
             source: data.source,
             warnings: data.warnings,
         })
@@ -326,6 +364,7 @@ impl Mesh {
             lights: self.lights.clone(),
             source: Source {
                 edited: true,
+                lod_chain: None,
                 ..self.source.clone()
             },
             warnings: self.warnings.clone(),
@@ -414,9 +453,14 @@ impl Mesh {
     pub fn aabb(&self) -> Aabb {
         self.aabb
     }
-    /// Bounding sphere (Ritter 1990; contains every vertex).
+    /// The minimal enclosing sphere of the vertices (Welzl 1991): what renders are framed by and
+    /// on-screen sizes are measured by.
     pub fn bounding_sphere(&self) -> Sphere {
         self.sphere
+    }
+    /// The bounds Unity, Unreal and glTF `MSFT_lod` readers measure LOD switches by.
+    pub fn engine_bounds(&self) -> EngineBounds {
+        self.engine_bounds
     }
     /// Provenance.
     pub fn source(&self) -> &Source {
@@ -450,6 +494,8 @@ pub fn load(path: &Path, options: &LoadOptions) -> Result<Mesh> {
 /// or a parser crate as the bug it is rather than as a handled error.
 #[doc(hidden)]
 pub fn load_unguarded(path: &Path, options: &LoadOptions) -> Result<Mesh> {
+    let (path, level) = split_level(path);
+    let path = path.as_path();
     let format = Format::from_path(path)?;
     if !path.exists() {
         return Err(Error::input(path, "file not found", "check the path"));
@@ -464,7 +510,7 @@ pub fn load_unguarded(path: &Path, options: &LoadOptions) -> Result<Mesh> {
     let data = match format {
         Format::Obj => obj::load(path, options),
         Format::Ply => ply::load(path),
-        Format::Gltf => gltf::load(path, options),
+        Format::Gltf => gltf::load(path, options, level),
         Format::Off => off::load(path),
     }?;
     Mesh::new(data, options)

@@ -445,6 +445,7 @@ pub(crate) fn load(path: &Path, options: &LoadOptions) -> Result<MeshData> {
             edited: false,
             files,
             nodes: Vec::new(),
+            lod_chain: None,
         },
         warnings,
     })

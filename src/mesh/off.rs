@@ -123,6 +123,7 @@ pub(crate) fn load(path: &Path) -> Result<MeshData> {
             edited: false,
             files: vec![path.to_path_buf()],
             nodes: Vec::new(),
+            lod_chain: None,
         },
         warnings: vec![],
     })

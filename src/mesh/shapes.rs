@@ -31,6 +31,7 @@ fn finish(name: &str, positions: Vec<Vec3>, triangles: Vec<[u32; 3]>) -> Mesh {
             edited: false,
             files: Vec::new(),
             nodes: Vec::new(),
+            lod_chain: None,
         },
         warnings: vec![],
     };

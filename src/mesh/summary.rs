@@ -91,8 +91,27 @@ pub struct MeshSummary {
     pub diagonal: f32,
     /// Bounding sphere in model units.
     pub bounding_sphere: Sphere,
+    /// glTF `MSFT_lod`: the chain the file holds and the level this summary describes.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub lod_chain: Option<super::LodChain>,
+    /// Every level of that chain ([`MeshSummary::with_levels`]), finest first.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub lod_levels: Vec<LevelSummary>,
     /// Non-fatal problems met while loading.
     pub warnings: Vec<String>,
+}
+
+/// One level of an `MSFT_lod` chain.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct LevelSummary {
+    /// Its number: `FILE#level` loads it.
+    pub level: usize,
+    /// Its triangles.
+    pub triangles: usize,
+    /// Its vertices (after seam splits).
+    pub vertices: usize,
+    /// The `MSFT_screencoverage` down to which it is used, where the file gives one.
+    pub coverage: Option<f64>,
 }
 
 impl MeshSummary {
@@ -156,8 +175,29 @@ impl MeshSummary {
             aabb: mesh.aabb(),
             diagonal: mesh.aabb().diagonal(),
             bounding_sphere: mesh.bounding_sphere(),
+            lod_chain: src.lod_chain.clone(),
+            lod_levels: Vec::new(),
             warnings: mesh.warnings().to_vec(),
         }
+    }
+
+    /// [`MeshSummary::of`], and for a file with an `MSFT_lod` chain every level's counts, each
+    /// level loaded as `FILE#K` with `options`.
+    pub fn with_levels(mesh: &Mesh, options: &super::LoadOptions) -> crate::Result<MeshSummary> {
+        let mut summary = MeshSummary::of(mesh);
+        if let Some(chain) = &summary.lod_chain {
+            let file = mesh.source().path.to_string_lossy().into_owned();
+            for level in 0..chain.levels {
+                let m = super::load(std::path::Path::new(&format!("{file}#{level}")), options)?;
+                summary.lod_levels.push(LevelSummary {
+                    level,
+                    triangles: m.triangle_count(),
+                    vertices: m.vertex_count(),
+                    coverage: chain.coverage.as_ref().and_then(|c| c.get(level).copied()),
+                });
+            }
+        }
+        Ok(summary)
     }
 }
 
@@ -243,6 +283,28 @@ impl std::fmt::Display for MeshSummary {
                     f,
                     "    {:<24} {}x{} TEXCOORD_{} {}",
                     t.role, t.width, t.height, t.tex_coord, t.source
+                )?;
+            }
+        }
+        if let Some(chain) = &self.lod_chain {
+            let loaded = chain.level.unwrap_or(0);
+            writeln!(
+                f,
+                "MSFT_lod chain       {} levels on node '{}'; this is level #{loaded}{} (FILE#K \
+                 loads level K)",
+                chain.levels,
+                chain.node,
+                if loaded == 0 { ", the finest" } else { "" }
+            )?;
+            for l in &self.lod_levels {
+                let coverage = match l.coverage {
+                    Some(c) => format!("used down to {c:.6} screen coverage"),
+                    None => "no screen coverage given".into(),
+                };
+                writeln!(
+                    f,
+                    "  #{:<3} {:>10} triangles {:>10} vertices   {coverage}",
+                    l.level, l.triangles, l.vertices
                 )?;
             }
         }

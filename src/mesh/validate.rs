@@ -283,6 +283,7 @@ mod tests {
                 edited: false,
                 files: Vec::new(),
                 nodes: Vec::new(),
+                lod_chain: None,
             },
             warnings: vec![],
         }

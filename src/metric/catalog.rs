@@ -78,8 +78,9 @@ pub struct Entry {
     pub family: MetricFamily,
     /// A chart's axis title.
     pub title: &'static str,
-    /// Whether it comes with a per-pixel map (a heat map, a share of pixels over a level).
-    pub has_map: bool,
+    /// What its per-pixel map holds (larger is worse), for metrics that have one (a heat map, a
+    /// share of pixels over a level, a worst pixel).
+    pub map: Option<&'static str>,
 }
 
 const UNIT: (f64, f64) = (0.0, 1.0);
@@ -95,7 +96,7 @@ pub const CATALOG: [Entry; 10] = [
         range: UNIT,
         family: MetricFamily::Flip,
         title: "FLIP (0 = identical)",
-        has_map: true,
+        map: Some("ꟻLIP error"),
     },
     Entry {
         metric: Metric::FlipP95,
@@ -106,7 +107,7 @@ pub const CATALOG: [Entry; 10] = [
         range: UNIT,
         family: MetricFamily::Flip,
         title: "FLIP, 95th percentile of pixels",
-        has_map: false,
+        map: None,
     },
     Entry {
         metric: Metric::FlipShare,
@@ -117,7 +118,7 @@ pub const CATALOG: [Entry; 10] = [
         range: UNIT,
         family: MetricFamily::Flip,
         title: "share of pixels over the FLIP level",
-        has_map: false,
+        map: None,
     },
     Entry {
         metric: Metric::Ssim,
@@ -128,7 +129,7 @@ pub const CATALOG: [Entry; 10] = [
         range: (-1.0, 1.0),
         family: MetricFamily::Ssim,
         title: "SSIM (1 = identical)",
-        has_map: true,
+        map: Some("1 − SSIM"),
     },
     Entry {
         metric: Metric::Msssim,
@@ -139,7 +140,7 @@ pub const CATALOG: [Entry; 10] = [
         range: (-1.0, 1.0),
         family: MetricFamily::Msssim,
         title: "MS-SSIM (1 = identical)",
-        has_map: false,
+        map: None,
     },
     Entry {
         metric: Metric::Psnr,
@@ -148,10 +149,10 @@ pub const CATALOG: [Entry; 10] = [
                idiff), dB",
         unit: "dB",
         worse: Worse::Lower,
-        range: (0.0, f64::INFINITY),
+        range: (0.0, super::mse::PSNR_CEILING_DB),
         family: MetricFamily::Psnr,
         title: "PSNR (8-bit sRGB), dB (higher is closer)",
-        has_map: false,
+        map: None,
     },
     Entry {
         metric: Metric::PsnrLuminance,
@@ -159,10 +160,10 @@ pub const CATALOG: [Entry; 10] = [
         what: "PSNR of linear luminance (peak 1), dB",
         unit: "dB",
         worse: Worse::Lower,
-        range: (f64::NEG_INFINITY, f64::INFINITY),
+        range: (f64::NEG_INFINITY, super::mse::PSNR_CEILING_DB),
         family: MetricFamily::Psnr,
         title: "PSNR (linear luminance), dB (higher is closer)",
-        has_map: false,
+        map: None,
     },
     Entry {
         metric: Metric::Mse,
@@ -173,7 +174,7 @@ pub const CATALOG: [Entry; 10] = [
         range: (0.0, f64::INFINITY),
         family: MetricFamily::Psnr,
         title: "MSE (linear luminance)",
-        has_map: false,
+        map: None,
     },
     Entry {
         metric: Metric::Vdp,
@@ -184,7 +185,7 @@ pub const CATALOG: [Entry; 10] = [
         range: UNIT,
         family: MetricFamily::Vdp,
         title: "VDP detection probability",
-        has_map: true,
+        map: Some("detection probability"),
     },
     Entry {
         metric: Metric::VdpJnd,
@@ -195,7 +196,7 @@ pub const CATALOG: [Entry; 10] = [
         range: (0.0, f64::INFINITY),
         family: MetricFamily::Vdp,
         title: "VDP, JND",
-        has_map: false,
+        map: None,
     },
 ];
 
@@ -272,7 +273,12 @@ impl Metric {
 
     /// Whether it has a per-pixel map.
     pub fn has_map(self) -> bool {
-        self.entry().has_map
+        self.entry().map.is_some()
+    }
+
+    /// What its per-pixel map holds (`1 − SSIM` for SSIM), where it has one.
+    pub fn map_label(self) -> Option<&'static str> {
+        self.entry().map
     }
 
     /// `Err` with the reason when `limit` (a gate's value, named `flag`) could never fail, or

@@ -15,9 +15,48 @@ pub fn magma(v: f32) -> [u8; 3] {
     table[((v.clamp(0.0, 1.0) * 255.0 + 0.5) as usize).min(255)]
 }
 
+/// The numbers of a legend strip: (place along the strip in [0, 1], text).
+pub type Legend = [(f32, &'static str)];
+
+/// The legend of maps whose values are in [0, 1].
+pub const UNIT_LEGEND: [(f32, &str); 5] = [
+    (0.0, "0"),
+    (0.25, "0.25"),
+    (0.5, "0.5"),
+    (0.75, "0.75"),
+    (1.0, "1"),
+];
+
+/// The JND scale of VDP heat maps: log₂ from ¼ to 16 JND (six octaves), so 1 JND — the
+/// observers' threshold — sits a third of the way along and a glaring difference still differs
+/// from a clear one.
+pub const JND_LEGEND: [(f32, &str); 5] = [
+    (0.0, "1/4"),
+    (1.0 / 3.0, "1 JND"),
+    (0.5, "2"),
+    (2.0 / 3.0, "4"),
+    (1.0, "16 JND"),
+];
+
+/// A JND value on [`JND_LEGEND`]'s scale, in [0, 1].
+pub fn jnd_scale(jnd: f32) -> f32 {
+    ((jnd.max(1e-6).log2() + 2.0) / 6.0).clamp(0.0, 1.0)
+}
+
 /// An RGB heat map of `values` (row-major, `width` wide) with a `legend`-pixel-high magma strip
 /// from 0 (left) to 1 (right) underneath when `legend > 0`.
 pub fn heat_map(values: &[f32], width: usize, height: usize, legend: usize) -> image::RgbImage {
+    heat_map_with(values, width, height, legend, &UNIT_LEGEND)
+}
+
+/// [`heat_map`] with the legend's numbers given (values already on the strip's 0 … 1 scale).
+pub fn heat_map_with(
+    values: &[f32],
+    width: usize,
+    height: usize,
+    legend: usize,
+    labels: &Legend,
+) -> image::RgbImage {
     let mut img = image::RgbImage::new(width as u32, (height + legend) as u32);
     for (px, &v) in img.as_mut().chunks_exact_mut(3).zip(values) {
         px.copy_from_slice(&magma(v));
@@ -33,7 +72,7 @@ pub fn heat_map(values: &[f32], width: usize, height: usize, legend: usize) -> i
         }
     }
     if legend >= MIN_LABELLED_LEGEND && width >= 120 {
-        label_legend(&mut img, height as f32, legend as f32);
+        label_legend(&mut img, height as f32, legend as f32, labels);
     }
     img
 }
@@ -41,20 +80,19 @@ pub fn heat_map(values: &[f32], width: usize, height: usize, legend: usize) -> i
 /// The smallest legend strip (pixels high) that gets numbers.
 const MIN_LABELLED_LEGEND: usize = 12;
 
-/// Numbers 0, 0.25, 0.5, 0.75 and 1 inside the legend strip at their places, white on the dark
-/// end of the map and black on the light end.
-fn label_legend(img: &mut image::RgbImage, top: f32, legend: f32) {
+/// The legend's numbers inside the strip at their places, white on the dark end of the map and
+/// black on the light end.
+fn label_legend(img: &mut image::RgbImage, top: f32, legend: f32, labels: &Legend) {
     use crate::io::label::{self, Align, Style};
     let px = (legend * 0.75).clamp(9.0, 14.0);
     let baseline = (top + (legend + label::ascent(px) * 0.75) / 2.0).round();
     let width = img.width() as f32;
-    for (v, text, align) in [
-        (0.0, "0", Align::Left),
-        (0.25, "0.25", Align::Center),
-        (0.5, "0.5", Align::Center),
-        (0.75, "0.75", Align::Center),
-        (1.0, "1", Align::Right),
-    ] {
+    for &(v, text) in labels {
+        let align = match v {
+            0.0 => Align::Left,
+            1.0 => Align::Right,
+            _ => Align::Center,
+        };
         let x = (v * (width - 1.0)).clamp(3.0, width - 4.0);
         let ink = if v < 0.6 { [255, 255, 255] } else { [0, 0, 0] };
         label::draw_rgb(img, text, x, baseline, Style::new(px, ink).align(align));
@@ -325,6 +363,21 @@ const MAGMA: [[f32; 3]; 256] = [
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_jnd_scale_puts_its_legend_numbers_where_it_says() {
+        for &(at, text) in &JND_LEGEND {
+            let jnd = match text {
+                "1/4" => 0.25,
+                "1 JND" => 1.0,
+                "16 JND" => 16.0,
+                t => t.parse().unwrap(),
+            };
+            assert!((jnd_scale(jnd) - at).abs() < 1e-6, "{text}");
+        }
+        assert_eq!(jnd_scale(0.0), 0.0);
+        assert_eq!(jnd_scale(1e6), 1.0);
+    }
 
     #[test]
     fn ends_and_monotone_lightness() {

@@ -35,11 +35,17 @@ impl Rig {
     /// Cameras for every view, in view-number order, each framing `mesh`'s bounding sphere at the
     /// default field of view and margin, for images of width/height `aspect`.
     pub fn cameras(&self, mesh: &Mesh, aspect: f32) -> Vec<Camera> {
+        self.cameras_framing(mesh.bounding_sphere(), aspect)
+    }
+
+    /// Cameras for every view framing `sphere` (another mesh's, to render a LOD exactly as its
+    /// original was framed).
+    pub fn cameras_framing(&self, sphere: crate::mesh::Sphere, aspect: f32) -> Vec<Camera> {
         self.directions()
             .into_iter()
             .map(|d| {
                 Camera::frame_sphere(
-                    mesh.bounding_sphere(),
+                    sphere,
                     d,
                     Camera::DEFAULT_FOV_Y_DEG,
                     aspect,

@@ -375,8 +375,12 @@ fn diff_gates_grade_exit_codes_and_report_the_worst_pixel() {
     assert!(
         (w["value"].as_f64().unwrap() - v[0]["percentiles"]["max"].as_f64().unwrap()).abs() < 1e-6
     );
-    // PSNR gates the other way: below the limit fails.
-    assert_eq!(run(&["--metric", "psnr", "--fail", "200"]).code, 1);
+    // PSNR gates the other way: below the limit fails. Past its 100 dB ceiling a limit could
+    // only ever fail, and is refused.
+    assert_eq!(run(&["--metric", "psnr", "--fail", "99"]).code, 1);
+    let never = run(&["--metric", "psnr", "--fail", "200"]);
+    assert_eq!(never.code, 2, "{}", never.stderr);
+    assert!(never.stderr.contains("always fail"), "{}", never.stderr);
     assert_eq!(run(&["--metric", "psnr", "--fail", "1"]).code, 0);
     // Percentage gates need a metric with a per-pixel map.
     let bad = run(&[

@@ -9,6 +9,8 @@
 //!   chains on every shipped model).
 //! - `export`: LOD chains as glTF with `MSFT_lod` and measured `MSFT_screencoverage`, from
 //!   `eval` and `simplify`, read back with the `gltf` crate.
+//! - `first_hour`: what a new user does after the quick start (issue 55): renders framed alike
+//!   and misframed ones named by `diff`, labelled values.
 //! - `fuzz`: property-based mutation fuzzing of the OBJ, PLY, OFF and GLB paths.
 //! - `hostile`: hostile input by class (`hostile/mod.rs` lists them): refused with exit 2, never
 //!   an abort, a hang or a silently wrong pass.
@@ -42,6 +44,7 @@ mod cli;
 mod common;
 mod eval;
 mod export;
+mod first_hour;
 mod function_length;
 mod fuzz;
 #[cfg(feature = "gpu")]

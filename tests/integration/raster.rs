@@ -174,6 +174,7 @@ fn quad_mesh() -> Mesh {
             edited: false,
             files: Vec::new(),
             nodes: Vec::new(),
+            lod_chain: None,
         },
         warnings: vec![],
     };

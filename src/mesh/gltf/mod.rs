@@ -8,6 +8,12 @@
 //! transform; each image decoded once per colour space). `TEXCOORD_0` and `TEXCOORD_1`, `COLOR_0`
 //! (RGB; an alpha below 1 is a warning) and `KHR_lights_punctual` lights (at their nodes' world
 //! transforms) are read.
+//!
+//! `MSFT_lod` chains: a node with the extension is loaded as its level 0 (its own mesh and
+//! children) unless a level K is asked for (`FILE.glb#K`), which loads the node its `ids` list
+//! K-th instead, under the same parent transform. Either way the chain (levels, the
+//! `extras.MSFT_screencoverage` values) is recorded in the mesh's `Source`, so a caller can tell
+//! "the original of a chain" from "a plain mesh".
 
 use std::path::Path;
 
@@ -17,7 +23,8 @@ mod check;
 
 use crate::error::{Error, Location, Result};
 use crate::mesh::{
-    FileLight, Format, LightKind, LoadOptions, Material, MeshData, Source, SourceNode, read_file,
+    FileLight, Format, LightKind, LoadOptions, LodChain, Material, MeshData, Source, SourceNode,
+    read_file,
 };
 
 pub(super) const REEXPORT: &str =
@@ -35,6 +42,9 @@ struct Builder {
     color_alpha: bool,
     lights: Vec<FileLight>,
     nodes: Vec<SourceNode>,
+    /// The first `MSFT_lod` chain met, and how many nodes carried one.
+    chain: Option<LodChain>,
+    chains: usize,
     triangles: Vec<[u32; 3]>,
     material_ids: Vec<u32>,
     file_vertices: usize,
@@ -42,8 +52,8 @@ struct Builder {
     warnings: Vec<String>,
 }
 
-/// Load a glTF or GLB file.
-pub(crate) fn load(path: &Path, options: &LoadOptions) -> Result<MeshData> {
+/// Load a glTF or GLB file; with `level`, level K of its `MSFT_lod` chain.
+pub(crate) fn load(path: &Path, options: &LoadOptions, level: Option<usize>) -> Result<MeshData> {
     let bytes = read_file(path)?;
     check::check_glb_header(path, &bytes)?;
     let invalid =
@@ -77,7 +87,20 @@ pub(crate) fn load(path: &Path, options: &LoadOptions) -> Result<MeshData> {
     check::check_tex_coords(path, document.as_json())?;
 
     let mut b = Builder::default();
-    walk_scene(path, &document, &buffers, default_id, &mut b)?;
+    walk_scene(path, &document, &buffers, default_id, level, &mut b)?;
+    if let (Some(k), None) = (level, &b.chain) {
+        return Err(Error::input(
+            path,
+            format!("has no MSFT_lod chain, so it has no level #{k}"),
+            "name the file without '#…'",
+        ));
+    }
+    if b.chains > 1 {
+        b.warnings.push(format!(
+            "{} nodes carry MSFT_lod chains; the level is taken from each",
+            b.chains
+        ));
+    }
     if b.material_ids.contains(&default_id) {
         materials.push(Material::default_material());
     }
@@ -153,6 +176,7 @@ fn walk_scene(
     document: &gltf::Document,
     buffers: &[gltf::buffer::Data],
     default_id: u32,
+    level: Option<usize>,
     b: &mut Builder,
 ) -> Result<()> {
     let roots: Vec<(gltf::Node, Mat4)> = match document
@@ -170,6 +194,7 @@ fn walk_scene(
     let mut stack = roots;
     stack.reverse();
     while let Some((node, parent)) = stack.pop() {
+        let node = lod_level(path, document, node, level, b)?;
         let world = parent * Mat4::from_cols_array_2d(&node.transform().matrix());
         if let Some(mesh) = node.mesh() {
             add_mesh(path, b, &mesh, world, buffers, default_id)?;
@@ -190,6 +215,68 @@ fn walk_scene(
         }
     }
     Ok(())
+}
+
+/// The node to load for `node`: itself, or with `level` K ≥ 1 and an `MSFT_lod` extension, the
+/// K-th node of its `ids`. Records the chain in `b`.
+fn lod_level<'a>(
+    path: &Path,
+    document: &'a gltf::Document,
+    node: gltf::Node<'a>,
+    level: Option<usize>,
+    b: &mut Builder,
+) -> Result<gltf::Node<'a>> {
+    let Some(ext) = node.extension_value("MSFT_lod") else {
+        return Ok(node);
+    };
+    let name = node
+        .name()
+        .map_or_else(|| format!("node {}", node.index()), str::to_string);
+    let bad = |what: String| {
+        Error::input_at(
+            path,
+            Location::Element(format!("node '{name}' MSFT_lod")),
+            what,
+            REEXPORT,
+        )
+    };
+    let ids: Vec<usize> = match ext.get("ids").and_then(|v| v.as_array()) {
+        Some(ids) => ids
+            .iter()
+            .map(|v| {
+                v.as_u64()
+                    .map(|i| i as usize)
+                    .filter(|&i| i < document.nodes().len())
+            })
+            .collect::<Option<_>>()
+            .ok_or_else(|| bad("`ids` names a node that is not in the file".into()))?,
+        None => return Err(bad("has no `ids` list".into())),
+    };
+    let coverage = node
+        .extras()
+        .as_ref()
+        .and_then(|raw| serde_json::from_str::<serde_json::Value>(raw.get()).ok())
+        .and_then(|v| serde_json::from_value(v.get("MSFT_screencoverage")?.clone()).ok());
+    let levels = ids.len() + 1;
+    b.chains += 1;
+    b.chain.get_or_insert(LodChain {
+        node: name.clone(),
+        levels,
+        coverage,
+        level,
+    });
+    match level {
+        None | Some(0) => Ok(node),
+        Some(k) if k < levels => Ok(document.nodes().nth(ids[k - 1]).expect("checked above")),
+        Some(k) => Err(Error::input(
+            path,
+            format!(
+                "has no level #{k}: node '{name}' has MSFT_lod levels #0 (the finest) to #{}",
+                levels - 1
+            ),
+            "name a level that exists",
+        )),
+    }
 }
 
 impl Builder {
@@ -226,6 +313,7 @@ impl Builder {
                 edited: false,
                 files,
                 nodes: b.nodes,
+                lod_chain: b.chain,
             },
             warnings,
         }

@@ -178,6 +178,10 @@ pub struct VdpScore {
     /// Per-pixel detection probability in [0, 1] of the difference around the pixel
     /// ([`MAP_WINDOW_DEG`]); never above `probability`.
     pub map: ErrorMap,
+    /// The same neighbourhood's difference in JND (1 = threshold): unlike the probability,
+    /// which saturates at 1 a little past 2 JND, it still tells a clear difference from a glaring
+    /// one (the heat maps `eval` draws).
+    pub jnd_map: ErrorMap,
 }
 
 impl VdpPrepared {
@@ -387,12 +391,14 @@ impl Vdp {
         // Stage 6: one difference image, pooled over visual angle.
         let d = bands::collapse(masked, residual);
         let (sum, density) = pooling::minkowski(&d, self.ppd, self.params.beta);
-        let map = pooling::probability_map(&density, d.w, d.h, self.ppd);
+        let (map, jnd_map) =
+            pooling::probability_and_jnd_maps(&density, d.w, d.h, self.ppd, self.params.beta);
         // Stage 7.
         Ok(VdpScore {
             probability: psychometric::probability(sum),
             jnd: psychometric::jnd(sum, self.params.beta),
             map: reference.crop(map),
+            jnd_map: reference.crop(jnd_map),
         })
     }
 

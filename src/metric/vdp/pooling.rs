@@ -86,7 +86,37 @@ fn box_columns(src: &[f64], dst: &mut [f64], width: usize, r: usize) {
 }
 
 /// Per-pixel detection probability of the difference around each pixel (see the module comment).
+#[cfg(test)]
 pub(crate) fn probability_map(e: &[f64], w: usize, h: usize, ppd: f64) -> Vec<f32> {
+    local_sums(e, w, h, ppd)
+        .into_iter()
+        .map(|s| psychometric::probability(s) as f32)
+        .collect()
+}
+
+/// Per pixel, the detection probability and the size in JND (with exponent `beta`) of the
+/// difference around it: the same windowed sum read on both scales.
+pub(crate) fn probability_and_jnd_maps(
+    e: &[f64],
+    w: usize,
+    h: usize,
+    ppd: f64,
+    beta: f64,
+) -> (Vec<f32>, Vec<f32>) {
+    let sums = local_sums(e, w, h, ppd);
+    let p = sums
+        .par_iter()
+        .map(|&s| psychometric::probability(s) as f32)
+        .collect();
+    let j = sums
+        .par_iter()
+        .map(|&s| psychometric::jnd(s, beta) as f32)
+        .collect();
+    (p, j)
+}
+
+/// The pooled sum S within the Gaussian neighbourhood of each pixel (peak weight 1).
+fn local_sums(e: &[f64], w: usize, h: usize, ppd: f64) -> Vec<f64> {
     let sigma = MAP_WINDOW_DEG * ppd;
     // Three boxes of width 2r+1 have variance 3·((2r+1)² − 1)/12 = r(r+1); r(r+1) ≈ σ².
     let r = ((0.25 + sigma * sigma).sqrt() - 0.5).round().max(0.0) as usize;
@@ -129,7 +159,7 @@ pub(crate) fn probability_map(e: &[f64], w: usize, h: usize, ppd: f64) -> Vec<f3
             cur
         })
         .collect();
-    let mut out = vec![0.0f32; w * h];
+    let mut out = vec![0.0f64; w * h];
     out.par_chunks_mut(w).enumerate().for_each(|(y, row)| {
         for (x, o) in row.iter_mut().enumerate() {
             let windowed = if r == 0 {
@@ -139,7 +169,7 @@ pub(crate) fn probability_map(e: &[f64], w: usize, h: usize, ppd: f64) -> Vec<f3
                 let bw = COLUMN_BLOCK.min(w - b * COLUMN_BLOCK);
                 blocks[b][y * bw + i] * scale
             };
-            *o = psychometric::probability(windowed) as f32;
+            *o = windowed;
         }
     });
     out
@@ -148,6 +178,24 @@ pub(crate) fn probability_map(e: &[f64], w: usize, h: usize, ppd: f64) -> Vec<f3
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_jnd_map_is_the_probability_map_on_the_jnd_scale() {
+        let (w, h) = (40, 30);
+        let mut e = vec![0.0f64; w * h];
+        e[10 * w + 12] = 3e-3;
+        e[20 * w + 30] = 5.0;
+        let beta = 2.8;
+        let (p, j) = probability_and_jnd_maps(&e, w, h, 67.0, beta);
+        for (&p, &j) in p.iter().zip(&j) {
+            // P = 1 − exp(−k·J^β): the same windowed sum read twice.
+            let back = psychometric::probability((j as f64).powf(beta));
+            assert!((back - p as f64).abs() < 1e-5, "{p} {j}");
+        }
+        // Where the probability saturates the JND still grows.
+        let strong = j.iter().cloned().fold(0.0, f32::max);
+        assert!(strong > 1.0, "{strong}");
+    }
 
     #[test]
     fn pooling_is_in_degrees_not_pixels() {

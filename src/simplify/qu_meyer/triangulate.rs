@@ -368,6 +368,7 @@ impl Built {
             lights: Vec::new(),
             source: crate::mesh::Source {
                 edited: true,
+                lod_chain: None,
                 ..mesh.source().clone()
             },
             warnings: Vec::new(),
