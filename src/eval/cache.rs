@@ -117,6 +117,10 @@ impl RenderCache {
             h.update((bytes.len() as u64).to_le_bytes());
             h.update(&bytes);
         }
+        // Levels of one glTF MSFT_lod chain share every file: the level tells them apart.
+        if let Some(chain) = &mesh.source().lod_chain {
+            h.update(format!("MSFT_lod level {:?}", chain.level.unwrap_or(0)).as_bytes());
+        }
         let s = scene.scene();
         h.update(
             format!(

@@ -360,3 +360,61 @@ fn the_readme_first_steps_run_as_written() {
         }
     }
 }
+
+#[test]
+fn levels_of_one_chain_are_different_originals_to_the_render_cache() {
+    // Two assets whose originals are levels 0 and 1 of one file: every file they read is the
+    // same, so the cache must key on the level too, or the second asset's reference frames are
+    // the first's.
+    let dir = tempfile::tempdir().unwrap();
+    let src = model("bunny/bunny_odedstein_3k.obj");
+    let r = simplify(&src, &dir.path().join("chain.glb"), &["--chain", "0.5,0.1"]);
+    assert_eq!(r.code, 0, "{}", r.stderr);
+    let config = "[render]\nsize = 64\n[distance]\nenabled = false\n[images]\nheatmaps = \"none\"\n\
+                  contact_sheets = false\n[[asset]]\nname = \"a\"\nmesh = \"chain.glb#0\"\n\
+                  lods = [{ mesh = \"chain.glb#2\", name = \"l\" }]\n[[asset]]\nname = \"b\"\n\
+                  mesh = \"chain.glb#1\"\nlods = [{ mesh = \"chain.glb#2\", name = \"l\" }]\n";
+    let cfg = dir.path().join("c.toml");
+    std::fs::write(&cfg, format!("out = \"plain\"\n{config}")).unwrap();
+    let r = lodeval(["eval", cfg.to_str().unwrap(), "-q"]);
+    assert_eq!(r.code, 0, "{}", r.stderr);
+    std::fs::write(&cfg, format!("out = \"cached\"\n{config}")).unwrap();
+    let cache = dir.path().join("cache");
+    let r = lodeval([
+        "eval",
+        cfg.to_str().unwrap(),
+        "-q",
+        "--cache",
+        cache.to_str().unwrap(),
+    ]);
+    assert_eq!(r.code, 0, "{}", r.stderr);
+    let read = |d: &str| std::fs::read_to_string(dir.path().join(d).join("metrics.csv")).unwrap();
+    assert_eq!(read("plain"), read("cached"));
+}
+
+#[test]
+fn a_broken_msft_lod_list_is_named_when_a_level_is_asked_for_and_ignored_otherwise() {
+    let dir = tempfile::tempdir().unwrap();
+    let chain = dir.path().join("chain.gltf");
+    let r = simplify(
+        &model("bunny/bunny_odedstein_3k.obj"),
+        &chain,
+        &["--chain", "0.5"],
+    );
+    assert_eq!(r.code, 0, "{}", r.stderr);
+    let text = std::fs::read_to_string(&chain).unwrap();
+    let mut doc: serde_json::Value = serde_json::from_str(&text).unwrap();
+    doc["nodes"][0]["extensions"]["MSFT_lod"]["ids"] = serde_json::json!([99]);
+    std::fs::write(&chain, serde_json::to_string(&doc).unwrap()).unwrap();
+    let c = chain.to_str().unwrap();
+    let r = lodeval(["info", c]);
+    assert_eq!(r.code, 0, "{}", r.stderr);
+    assert!(r.stdout.contains("the chain is ignored"), "{}", r.stdout);
+    let r = lodeval(["info", &format!("{c}#1")]);
+    assert_eq!(r.code, 2, "{}", r.stderr);
+    assert!(
+        r.stderr.contains("MSFT_lod") && r.stderr.contains("not in the file"),
+        "{}",
+        r.stderr
+    );
+}

@@ -240,17 +240,25 @@ fn lod_level<'a>(
             REEXPORT,
         )
     };
-    let ids: Vec<usize> = match ext.get("ids").and_then(|v| v.as_array()) {
-        Some(ids) => ids
-            .iter()
+    let ids: Option<Vec<usize>> = ext.get("ids").and_then(|v| v.as_array()).and_then(|ids| {
+        ids.iter()
             .map(|v| {
                 v.as_u64()
                     .map(|i| i as usize)
                     .filter(|&i| i < document.nodes().len())
             })
-            .collect::<Option<_>>()
-            .ok_or_else(|| bad("`ids` names a node that is not in the file".into()))?,
-        None => return Err(bad("has no `ids` list".into())),
+            .collect()
+    });
+    let Some(ids) = ids else {
+        let what = "`ids` is missing or names a node that is not in the file";
+        // Only a level asked for needs the chain; otherwise the node loads as it always did.
+        if level.is_some() {
+            return Err(bad(what.into()));
+        }
+        b.warnings.push(format!(
+            "node '{name}': MSFT_lod {what}; the chain is ignored and the node loaded as it is"
+        ));
+        return Ok(node);
     };
     let coverage = node
         .extras()
