@@ -5,8 +5,9 @@
 //! wide, seen from `distance_m` (the default viewing conditions). A pixel at the centre subtends
 //! 1/k radians with k = distance_m · display_px / display_width_m, which also fixes the engine
 //! camera's vertical field of view (cot(fov/2) = 2k / height_px). An object's size is its minimal
-//! enclosing sphere's (Welzl; [`crate::mesh::minimal_sphere`]): one whose sphere has radius R (metres) at distance D from the eye projects to a disc of diameter
-//! 2k·R/√(D² − R²) pixels; the inverse is D = R·√(1 + (2k/diameter)²).
+//! enclosing sphere's (Welzl; [`crate::mesh::minimal_sphere`]): one whose sphere has radius R
+//! (metres) at distance D from the eye projects to a disc of diameter 2k·R/√(D² − R²) pixels;
+//! the inverse is D = R·√(1 + (2k/diameter)²).
 //!
 //! Method. For a candidate on-screen diameter the original and the LOD are rendered exactly as
 //! that viewer would see them (perspective camera at distance D, the display's pixel scale, a

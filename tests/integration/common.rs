@@ -27,14 +27,33 @@ where
     S: AsRef<std::ffi::OsStr>,
 {
     let mut cmd = Command::new(env!("CARGO_BIN_EXE_lodeval"));
-    cmd.args(args).env_remove("RUST_BACKTRACE");
+    cmd.args(args);
     for (key, value) in env {
         match value {
             Some(v) => cmd.env(key, v),
             None => cmd.env_remove(key),
         };
     }
-    let out = cmd.output().expect("the lodeval binary runs");
+    output(cmd)
+}
+
+/// [`lodeval`] run in the folder `dir` (relative paths in `args` resolve there).
+pub fn lodeval_in<I, S>(dir: &Path, args: I) -> Run
+where
+    I: IntoIterator<Item = S>,
+    S: AsRef<std::ffi::OsStr>,
+{
+    let mut cmd = Command::new(env!("CARGO_BIN_EXE_lodeval"));
+    cmd.args(args).current_dir(dir);
+    output(cmd)
+}
+
+/// Run `cmd` (without a backtrace variable from the test's environment) to completion.
+fn output(mut cmd: Command) -> Run {
+    let out = cmd
+        .env_remove("RUST_BACKTRACE")
+        .output()
+        .expect("the lodeval binary runs");
     Run {
         code: out.status.code().unwrap_or(-1),
         stdout: String::from_utf8_lossy(&out.stdout).into_owned(),

@@ -282,16 +282,7 @@ fn run_readme_line(line: &str, cwd: &std::path::Path) -> crate::common::Run {
         .strip_prefix("lodeval ")
         .or_else(|| line.strip_prefix("cargo run --release -- "))
         .unwrap_or_else(|| panic!("not a lodeval command: {line}"));
-    let out = std::process::Command::new(env!("CARGO_BIN_EXE_lodeval"))
-        .args(args.split_whitespace())
-        .current_dir(cwd)
-        .output()
-        .unwrap();
-    crate::common::Run {
-        code: out.status.code().unwrap_or(-1),
-        stdout: String::from_utf8_lossy(&out.stdout).into_owned(),
-        stderr: String::from_utf8_lossy(&out.stderr).into_owned(),
-    }
+    crate::common::lodeval_in(cwd, args.split_whitespace())
 }
 
 #[test]

@@ -53,7 +53,7 @@ fn box_line(line: &mut [f64], r: usize, tmp: &mut Vec<f64>) {
     }
 }
 
-/// Columns per block of [`probability_map`]'s vertical pass.
+/// Columns per block of [`local_sums`]' vertical pass.
 const COLUMN_BLOCK: usize = 64;
 
 /// [`box_line`] down every column of `src` (`width` columns, row-major) at once, into `dst`.
@@ -83,15 +83,6 @@ fn box_columns(src: &[f64], dst: &mut [f64], width: usize, r: usize) {
             *a += add - sub;
         }
     }
-}
-
-/// Per-pixel detection probability of the difference around each pixel (see the module comment).
-#[cfg(test)]
-pub(crate) fn probability_map(e: &[f64], w: usize, h: usize, ppd: f64) -> Vec<f32> {
-    local_sums(e, w, h, ppd)
-        .into_iter()
-        .map(|s| psychometric::probability(s) as f32)
-        .collect()
 }
 
 /// Per pixel, the detection probability and the size in JND (with exponent `beta`) of the
@@ -224,7 +215,7 @@ mod tests {
         d.v[20 * w + 30] = 4.0;
         d.v[5 * w + 3] = 2.0;
         let (s, e) = minkowski(&d, 67.0, 2.8);
-        let map = probability_map(&e, w, h, 67.0);
+        let map = probability_and_jnd_maps(&e, w, h, 67.0, 2.8).0;
         let p = psychometric::probability(s) as f32;
         let max = map.iter().cloned().fold(0.0, f32::max);
         assert!(max <= p + 1e-6 && max > 0.5 * p, "{max} {p}");
